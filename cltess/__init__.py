@@ -1,0 +1,25 @@
+"""cltess: crack-free, error-bounded tessellation of curved patches with OpenCL (CudaTess port).
+
+>>> from cltess import load_scene, Tessellator, export
+>>> tess = Tessellator().tessellate(load_scene("scenes/teapot.bez"), eps=1e-3)
+>>> export(tess, "teapot.ply")
+"""
+from .scene import Camera, Scene, SceneError
+from .tessellation import Tessellation
+
+
+def __getattr__(name):
+    # Lazy: importing cltess must not need an OpenCL platform.
+    if name == "Tessellator":
+        from .pipeline import Tessellator
+        return Tessellator
+    if name == "load_scene":
+        from .formats import load_scene
+        return load_scene
+    if name == "export":
+        from .export import export
+        return export
+    raise AttributeError(name)
+
+
+__all__ = ["Camera", "Scene", "SceneError", "Tessellation", "Tessellator", "load_scene", "export"]

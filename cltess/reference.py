@@ -1,0 +1,339 @@
+"""Plain NumPy reference of every pipeline stage: slow, float64, obviously right.
+
+Each function mirrors one kernel in ``kernels/`` (same name, same layout) so that the tests can
+check the kernel against it on random input.  Nothing here is used on the fast path.
+
+Conventions (see ``cltess/scene.py``): ``patches[p, j, i] = (w*x, w*y, w*z, w)``, edges
+numbered counter-clockwise 0: v=0, 1: u=1, 2: v=1, 3: u=0.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .scene import Camera, boundary_curves
+
+DEFAULT_MAX_FACTOR = 64
+
+
+# --- stage 1: tolerances and Zheng-Sederberg factors (DESIGN.md sections 2 and 7) -------------
+
+def patch_tolerances(patches: np.ndarray, eps: float | None = None, pixels: float | None = None,
+                     camera: Camera | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Per-patch object-space tolerance and culling.
+
+    patches: (P, 4, 4, 4).  Returns (eps (P,) float64, culled (P,) bool).
+    Object space: every patch gets ``eps``.  Screen space: ``eps = pixels * depth *
+    2 tan(fov_y/2) / height`` with ``depth`` the nearest depth of the patch's bounding box in
+    front of the camera; boxes entirely outside one frustum plane are culled.
+    """
+    count = len(patches)
+    if pixels is None:
+        return np.full(count, float(eps)), np.zeros(count, bool)
+    points = patches[..., :3] / patches[..., 3:]
+    lo, hi = points.min(axis=(1, 2)), points.max(axis=(1, 2))
+    corners = np.stack([np.where([(c >> a) & 1 for a in range(3)], hi, lo) for c in range(8)], axis=1)
+    view = camera.view_matrix()
+    cam = corners @ view[:3, :3].T + view[:3, 3]  # (P, 8, 3)
+    depth = -cam[..., 2]
+    tan_y = math.tan(math.radians(camera.fov_y_deg) / 2)
+    tan_x = tan_y * camera.width / camera.height
+    outside = [depth < camera.near, depth > camera.far,
+               cam[..., 0] > tan_x * depth, cam[..., 0] < -tan_x * depth,
+               cam[..., 1] > tan_y * depth, cam[..., 1] < -tan_y * depth]
+    culled = np.any([o.all(axis=1) for o in outside], axis=0)
+    nearest = np.maximum(depth.min(axis=1), camera.near)
+    return pixels * nearest * camera.pixel_size_at_unit_depth(), culled
+
+
+def zs_factors(patches: np.ndarray, eps: np.ndarray, culled: np.ndarray | None = None,
+               max_factor: int = DEFAULT_MAX_FACTOR) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Zheng-Sederberg factors (DESIGN.md section 2; CudaTess section 3, "Tessellation factors").
+
+    Returns (factors (P, 4) int32 ordered by edge, unclamped (P, 2) float64 = (1/du, 1/dv),
+    saturated (P,) bool).  Culled patches get factor 0 and are never saturated.
+    """
+    count = len(patches)
+    culled = np.zeros(count, bool) if culled is None else culled
+    factors = np.zeros((count, 4), np.int32)
+    unclamped = np.zeros((count, 2))
+    saturated = np.zeros(count, bool)
+    for p in range(count):
+        if culled[p]:
+            continue
+        inv_du, inv_dv = zs_inverse_steps(patches[p], eps[p])
+        unclamped[p] = inv_du, inv_dv
+        m, n = (min(max(math.ceil(x), 1), max_factor) if math.isfinite(x) else max_factor
+                for x in (inv_du, inv_dv))
+        saturated[p] = not (inv_du <= max_factor and inv_dv <= max_factor)
+        factors[p] = m, n, m, n
+    return factors, unclamped, saturated
+
+
+def zs_inverse_steps(patch: np.ndarray, eps: float) -> tuple[float, float]:
+    """(1/du, 1/dv) maximising du*dv under the ZS bound, for one (4, 4, 4) patch."""
+    points = patch[..., :3] / patch[..., 3:]
+    centre = (points.min(axis=(0, 1)) + points.max(axis=(0, 1))) / 2
+    w = patch[..., 3]
+    wp = patch[..., :3] - w[..., None] * centre  # translate to the box centre first
+    r = np.linalg.norm(points - centre, axis=-1).max()
+    slack = max(r - eps, 0.0)
+
+    def bound(d_wp, d_w):
+        return (np.linalg.norm(d_wp, axis=-1) + slack * np.abs(d_w)).max()
+
+    # [j, i]: u differences run along axis 1, v differences along axis 0.
+    d_uu = 6 * bound(wp[:, 2:] - 2 * wp[:, 1:-1] + wp[:, :-2], w[:, 2:] - 2 * w[:, 1:-1] + w[:, :-2])
+    d_vv = 6 * bound(wp[2:] - 2 * wp[1:-1] + wp[:-2], w[2:] - 2 * w[1:-1] + w[:-2])
+    d_uv = 9 * bound(wp[1:, 1:] - wp[1:, :-1] - wp[:-1, 1:] + wp[:-1, :-1],
+                     w[1:, 1:] - w[1:, :-1] - w[:-1, 1:] + w[:-1, :-1])
+    c = 8 * eps * w.min()
+    du, dv = zs_steps(d_uu, d_uv, d_vv, c)
+    return 1 / du, 1 / dv
+
+
+def zs_steps(d_uu: float, d_uv: float, d_vv: float, c: float) -> tuple[float, float]:
+    """Steps with ``d_uu du^2 + 2 d_uv du dv + d_vv dv^2 <= c`` and du*dv largest, at most 1.
+
+    The optimum has du/dv = sqrt(d_vv/d_uu) (Lagrange); with s = sqrt(d_uu), t = sqrt(d_vv):
+    du = sqrt(c t / (2 s (s t + d_uv))), dv = sqrt(c s / (2 t (s t + d_uv))), DESIGN.md's
+    formula without its 0 * inf.  Inputs are scaled by their max first; a step that still comes
+    out NaN (underflow) becomes 0, i.e. saturated, never silently coarse.
+    """
+    scale = max(d_uu, d_uv, d_vv)
+    if not scale > 0:
+        return 1.0, 1.0
+    a, d, b, c = d_uu / scale, d_uv / scale, d_vv / scale, c / scale
+    if a > 0 and b > 0:
+        s, t = math.sqrt(a), math.sqrt(b)
+        du = math.sqrt(c * t / (2 * s * (s * t + d))) if s * (s * t + d) > 0 else math.inf
+        dv = math.sqrt(c * s / (2 * t * (s * t + d))) if t * (s * t + d) > 0 else math.inf
+    elif a > 0:  # no v curvature: one step in v, solve u alone (stable quadratic root)
+        dv, du = 1.0, c / (d + math.sqrt(d * d + a * c))
+    elif b > 0:
+        du, dv = 1.0, c / (d + math.sqrt(d * d + b * c))
+    else:  # bilinear twist only
+        du = dv = math.sqrt(c / (2 * d))
+    return tuple(0.0 if math.isnan(x) else min(x, 1.0) for x in (du, dv))
+
+
+# --- stage 2: crack-free factors (DESIGN.md section 4) ------------------------------------------
+
+def crack_free_factors(factors: np.ndarray, group_of: np.ndarray, group_start: np.ndarray,
+                       members: np.ndarray) -> np.ndarray:
+    """Each patch edge takes the max factor over all patch edges of its group; culled stay 0.
+
+    factors: (P, 4); group_of: (4P,); group_start: (G+1,); members: (4P,).  Returns (P, 4).
+    """
+    flat = factors.reshape(-1)
+    out = np.zeros_like(flat)
+    for edge, group in enumerate(group_of):
+        if flat[edge] == 0:
+            continue
+        out[edge] = max(flat[members[k]] for k in range(group_start[group], group_start[group + 1]))
+    return out.reshape(factors.shape)
+
+
+# --- patterns (DESIGN.md section 5): local vertex parameters and triangles ----------------------
+
+def quad_pattern(f: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """The tessellation pattern of a quad patch with edge factors f (CudaTess Fig. 3).
+
+    Vertex layout, boundary first: the ring of ``R = f0+f1+f2+f3`` boundary points walking
+    counter-clockwise from (0, 0) (edge e, point k at ``t = k / f_e``), then the inner grid
+    ``(i / A, j / B)`` for ``j = 1..B-1``, ``i = 1..A-1`` row by row.
+
+    Uniform (f0 = f2 and f1 = f3): the regular A x B grid, A = f0, B = f1.  Otherwise the core
+    factors are ``A = max(min(f0, f2), 2)``, ``B = max(min(f1, f3), 2)``; the inner grid's cells
+    are split regularly and each edge's strip between boundary and inner grid is stitched
+    Bresenham-style, advancing the side whose next segment midpoint comes first.
+
+    Returns (uv (V, 2) float64, triangles (T, 3) int64 local indices, counter-clockwise in uv).
+    Culled patches (any factor 0) have no vertices and no triangles.
+    """
+    f = [int(x) for x in f]
+    if min(f) <= 0:
+        return np.zeros((0, 2)), np.zeros((0, 3), np.int64)
+    uniform = f[0] == f[2] and f[1] == f[3]
+    a = f[0] if uniform else max(min(f[0], f[2]), 2)
+    b = f[1] if uniform else max(min(f[1], f[3]), 2)
+    ring_size = sum(f)
+    base = np.cumsum([0] + f)
+
+    def ring(e, k):
+        return (base[e] + k) % ring_size
+
+    def inner(i, j):
+        return ring_size + (j - 1) * (a - 1) + (i - 1)
+
+    uv = []
+    for e in range(4):
+        for k in range(f[e]):
+            t = k / f[e]
+            uv.append([(t, 0.0), (1.0, t), (1.0 - t, 1.0), (0.0, 1.0 - t)][e])
+    uv += [(i / a, j / b) for j in range(1, b) for i in range(1, a)]
+
+    def grid(i, j):
+        if j == 0:
+            return ring(0, i)
+        if i == a:
+            return ring(1, j)
+        if j == b:
+            return ring(2, a - i)
+        if i == 0:
+            return ring(3, b - j)
+        return inner(i, j)
+
+    tris = []
+
+    def cells(i0, i1, j0, j1):
+        for j in range(j0, j1):
+            for i in range(i0, i1):
+                tris.append((grid(i, j), grid(i + 1, j), grid(i + 1, j + 1)))
+                tris.append((grid(i, j), grid(i + 1, j + 1), grid(i, j + 1)))
+
+    if uniform:
+        cells(0, a, 0, b)
+    else:
+        cells(1, a - 1, 1, b - 1)
+        inner_edge = [lambda k: inner(1 + k, 1), lambda k: inner(a - 1, 1 + k),
+                      lambda k: inner(a - 1 - k, b - 1), lambda k: inner(1, b - 1 - k)]
+        for e in range(4):
+            outer_n, core = f[e], (a if e % 2 == 0 else b)
+            inner_n = core - 2
+            o = k = 0
+            while o < outer_n or k < inner_n:
+                if k == inner_n or (o < outer_n and (2 * o + 1) * core <= (2 * k + 3) * outer_n):
+                    tris.append((ring(e, o), ring(e, o + 1), inner_edge[e](k)))
+                    o += 1
+                else:
+                    tris.append((ring(e, o), inner_edge[e](k + 1), inner_edge[e](k)))
+                    k += 1
+    return np.array(uv, float).reshape(-1, 2), np.array(tris, np.int64).reshape(-1, 3)
+
+
+# --- stage 3: counts and offsets --------------------------------------------------------------
+
+def counts(factors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(vertex counts (P,), index counts (P,)) of each patch's pattern."""
+    patterns = [quad_pattern(f) for f in factors]
+    return (np.array([len(uv) for uv, _ in patterns], np.int64),
+            np.array([3 * len(t) for _, t in patterns], np.int64))
+
+
+def offsets(counts_: np.ndarray) -> np.ndarray:
+    """Exclusive scan with the total appended: (P+1,)."""
+    return np.concatenate([[0], np.cumsum(counts_)]).astype(np.int64)
+
+
+# --- surface evaluation (DESIGN.md section 2) ---------------------------------------------------
+
+def bernstein3(t: np.ndarray) -> np.ndarray:
+    """(..., 4) cubic Bernstein basis."""
+    s = 1 - t
+    return np.stack([s ** 3, 3 * t * s * s, 3 * t * t * s, t ** 3], axis=-1)
+
+
+def bernstein3_derivative(t: np.ndarray) -> np.ndarray:
+    """(..., 4) derivatives of the cubic Bernstein basis."""
+    s = 1 - t
+    return np.stack([-3 * s * s, 3 * s * s - 6 * t * s, 6 * t * s - 3 * t * t, 3 * t * t], axis=-1)
+
+
+def homogeneous_and_derivatives(patch: np.ndarray, u: np.ndarray, v: np.ndarray):
+    """B, B_u, B_v (each (N, 4)) of one (4, 4, 4) patch at parameters u, v (N,)."""
+    bu, bv = bernstein3(u), bernstein3(v)
+    du, dv = bernstein3_derivative(u), bernstein3_derivative(v)
+    return (np.einsum("nj,ni,jic->nc", bv, bu, patch), np.einsum("nj,ni,jic->nc", bv, du, patch),
+            np.einsum("nj,ni,jic->nc", dv, bu, patch))
+
+
+def evaluate(patch: np.ndarray, u, v) -> tuple[np.ndarray, np.ndarray]:
+    """Positions and unit normals (N, 3) of a (4, 4, 4) rational patch at (u, v) (N,).
+
+    Normal ``t_u x t_v`` with ``t_u = (B_u.xyz - B_u.w p) / B.w``.  Where it vanishes (a
+    collapsed edge), the normal is taken a little way inside the domain (the limit direction).
+    """
+    u, v = np.atleast_1d(np.asarray(u, float)), np.atleast_1d(np.asarray(v, float))
+    b, b_u, b_v = homogeneous_and_derivatives(patch, u, v)
+    position = b[:, :3] / b[:, 3:]
+    normal = _normal(b, b_u, b_v)
+    bad = ~_normal_ok(normal, b, b_u, b_v)
+    if bad.any():
+        us, vs = u[bad] + NORMAL_SHIFT * (0.5 - u[bad]), v[bad] + NORMAL_SHIFT * (0.5 - v[bad])
+        normal[bad] = _normal(*homogeneous_and_derivatives(patch, us, vs))
+    length = np.linalg.norm(normal, axis=1, keepdims=True)
+    return position, np.where(length > 0, normal / np.where(length > 0, length, 1), [0.0, 0.0, 1.0])
+
+
+def surface_points(patches: np.ndarray, patch_ids: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Positions (N, 3) of many patches at once: sample n is patch ``patch_ids[n]`` at (u[n], v[n])."""
+    b = np.einsum("nj,ni,njic->nc", bernstein3(np.asarray(v, float)), bernstein3(np.asarray(u, float)),
+                  patches[patch_ids])
+    return b[:, :3] / b[:, 3:]
+
+
+NORMAL_SHIFT = 1.0e-3  # how far towards the domain centre a vanishing normal is re-evaluated
+
+
+def _normal(b, b_u, b_v):
+    p = b[:, :3] / b[:, 3:]
+    t_u = b_u[:, :3] - b_u[:, 3:] * p
+    t_v = b_v[:, :3] - b_v[:, 3:] * p
+    return np.cross(t_u, t_v)
+
+
+def _normal_ok(normal, b, b_u, b_v):
+    p = b[:, :3] / b[:, 3:]
+    t_u = b_u[:, :3] - b_u[:, 3:] * p
+    t_v = b_v[:, :3] - b_v[:, 3:] * p
+    scale = (t_u * t_u).sum(1) + (t_v * t_v).sum(1)
+    return (normal * normal).sum(1) > NORMAL_DEGENERATE ** 2 * scale * scale
+
+
+NORMAL_DEGENERATE = 1.0e-5  # |t_u x t_v| below this times |t_u|^2 + |t_v|^2 counts as vanished
+
+
+# --- stages 4 and 5: the whole tessellation --------------------------------------------------
+
+def tessellate(patches: np.ndarray, factors: np.ndarray, object_ids: np.ndarray | None = None) -> dict:
+    """Vertices and triangles of all patches at the given final factors (direct evaluation).
+
+    Returns a dict of positions (V, 3), normals (V, 3), uv (V, 2), patch_ids (V,),
+    object_ids (V,), triangles (T, 3): the layout the kernels write.
+    """
+    object_ids = np.zeros(len(patches), np.int32) if object_ids is None else object_ids
+    out = {k: [] for k in ("positions", "normals", "uv", "patch_ids", "object_ids", "triangles")}
+    first = 0
+    for p, f in enumerate(factors):
+        uv, tris = quad_pattern(f)
+        if not len(uv):
+            continue
+        pos, nrm = evaluate(patches[p], uv[:, 0], uv[:, 1])
+        out["positions"].append(pos)
+        out["normals"].append(nrm)
+        out["uv"].append(uv)
+        out["patch_ids"].append(np.full(len(uv), p))
+        out["object_ids"].append(np.full(len(uv), object_ids[p]))
+        out["triangles"].append(tris + first)
+        first += len(uv)
+    shapes = {"positions": (0, 3), "normals": (0, 3), "uv": (0, 2), "patch_ids": (0,),
+              "object_ids": (0,), "triangles": (0, 3)}
+    return {k: np.concatenate(v) if v else np.zeros(shapes[k]) for k, v in out.items()}
+
+
+def boundary_point(curve: np.ndarray, k: int, f: int) -> np.ndarray:
+    """Point k of f+1 on a rational cubic boundary curve (4, 4), placed symmetrically.
+
+    The kernel evaluates from the nearer end so both patches sharing the curve, walking it in
+    opposite directions, do the same arithmetic (Mesa's tessellator places points likewise).
+    """
+    b = curve if 2 * k <= f else curve[::-1]
+    t = min(k, f - k) / f
+    c = bernstein3(np.array(t)) @ b
+    return c[:3] / c[3]
+
+
+__all__ = ["patch_tolerances", "zs_factors", "zs_steps", "crack_free_factors", "quad_pattern",
+           "counts", "offsets", "evaluate", "surface_points", "tessellate", "boundary_point", "boundary_curves"]

@@ -1,0 +1,40 @@
+"""The result of a tessellation run: arrays in, arrays out (shapes in the field docs)."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass
+class Tessellation:
+    """A triangle mesh sampled from a scene's patches, with its per-patch bookkeeping.
+
+    positions:  (V, 3) float32
+    normals:    (V, 3) float32, unit length
+    uv:         (V, 2) float32, the patch parameters of each vertex
+    patch_ids:  (V,) int32, the patch each vertex belongs to
+    object_ids: (V,) int32, the object of that patch
+    triangles:  (T, 3) uint32, counter-clockwise seen from the normal side
+    factors:    (P, 4) int32, the final (crack-free) edge factors; 0 = culled
+    stage_ms:   device milliseconds per stage, from OpenCL profiling events
+    stats:      counts for the summary: patches, culled, saturated, shared/boundary edges...
+    """
+
+    positions: np.ndarray
+    normals: np.ndarray
+    uv: np.ndarray
+    patch_ids: np.ndarray
+    object_ids: np.ndarray
+    triangles: np.ndarray
+    factors: np.ndarray
+    stage_ms: dict = field(default_factory=dict)
+    stats: dict = field(default_factory=dict)
+
+    @property
+    def num_vertices(self) -> int:
+        return len(self.positions)
+
+    @property
+    def num_triangles(self) -> int:
+        return len(self.triangles)

@@ -1,0 +1,91 @@
+/* Stage 1: per-patch tolerance, frustum culling and Zheng-Sederberg edge factors.
+ * Mirror: cltess/reference.py patch_tolerances + zs_factors.  One work-item per patch. */
+#include "cltess.h"
+
+/* Object-space tolerance of a patch and whether it is culled (DESIGN.md section 7).
+ * camera_on == 0: every patch gets eps.  Otherwise eps = pixels * nearest depth * pixel_size,
+ * and a box entirely outside one frustum plane is culled. */
+inline float patch_tolerance(float3 lo, float3 hi, float eps, int camera_on, float16 view,
+                             float4 frustum, float pixels, float pixel_size, int *culled)
+{
+    *culled = 0;
+    if (!camera_on)
+        return eps;
+    float tan_x = frustum.s0, tan_y = frustum.s1, near = frustum.s2, far = frustum.s3;
+    int out_mask = 0x3f;  /* bit per plane: set while every corner so far is outside it */
+    float nearest = INFINITY;
+    for (int c = 0; c < 8; ++c) {
+        float3 w = (float3)((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
+        float x = dot(view.s012, w) + view.s3;
+        float y = dot(view.s456, w) + view.s7;
+        float depth = -(dot(view.s89a, w) + view.sb);
+        int outside = (depth < near) | (depth > far) << 1 | (x > tan_x * depth) << 2
+                    | (x < -tan_x * depth) << 3 | (y > tan_y * depth) << 4 | (y < -tan_y * depth) << 5;
+        out_mask &= outside;
+        nearest = min(nearest, depth);
+    }
+    *culled = out_mask != 0;
+    return pixels * max(nearest, near) * pixel_size;
+}
+
+/* factors[p] = (m, n, m, n) by edge; flags[p]: bit 0 saturated (the bound is not met at
+ * max_factor), bit 1 culled (factors 0). */
+__kernel void zs_factors(__global const float4 *patches, uint num_patches, float eps,
+                         int camera_on, float16 view, float4 frustum, float pixels,
+                         float pixel_size, int max_factor,
+                         __global int4 *factors, __global int *flags)
+{
+    uint p = get_global_id(0);
+    if (p >= num_patches)
+        return;
+    float4 b[16];
+    load_patch(patches, p, b);
+
+    float3 lo = b[0].xyz / b[0].w, hi = lo;
+    float min_w = b[0].w;
+    for (int k = 1; k < 16; ++k) {
+        float3 point = b[k].xyz / b[k].w;
+        lo = min(lo, point);
+        hi = max(hi, point);
+        min_w = min(min_w, b[k].w);
+    }
+    int culled;
+    float tol = patch_tolerance(lo, hi, eps, camera_on, view, frustum, pixels, pixel_size, &culled);
+    if (culled) {
+        factors[p] = (int4)(0);
+        flags[p] = 2;
+        return;
+    }
+
+    /* Translate to the box centre: the bound's r = max |P_ij| is not translation-invariant. */
+    float3 centre = 0.5f * (lo + hi);
+    float4 t[16];
+    float r = 0.0f;
+    for (int k = 0; k < 16; ++k) {
+        t[k] = (float4)(b[k].xyz - b[k].w * centre, b[k].w);
+        r = max(r, length(b[k].xyz / b[k].w - centre));
+    }
+    float slack = max(r - tol, 0.0f);
+
+    /* ||d(wP)|| + max(r - eps, 0) |dw| over the second differences (DESIGN.md section 2). */
+    float d_uu = 0.0f, d_vv = 0.0f, d_uv = 0.0f;
+    for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 2; ++i) {
+            float4 d = t[4 * j + i + 2] - 2.0f * t[4 * j + i + 1] + t[4 * j + i];
+            d_uu = max(d_uu, length(d.xyz) + slack * fabs(d.w));
+            float4 e = t[4 * (i + 2) + j] - 2.0f * t[4 * (i + 1) + j] + t[4 * i + j];
+            d_vv = max(d_vv, length(e.xyz) + slack * fabs(e.w));
+        }
+    for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 3; ++i) {
+            float4 d = t[4 * (j + 1) + i + 1] - t[4 * (j + 1) + i] - t[4 * j + i + 1] + t[4 * j + i];
+            d_uv = max(d_uv, length(d.xyz) + slack * fabs(d.w));
+        }
+    float2 step = zs_steps(6.0f * d_uu, 9.0f * d_uv, 6.0f * d_vv, 8.0f * tol * min_w);
+    float2 inverse = 1.0f / step;
+    int saturated = !(inverse.x <= (float)max_factor && inverse.y <= (float)max_factor);
+    int m = inverse.x <= (float)max_factor ? max((int)ceil(inverse.x), 1) : max_factor;
+    int n = inverse.y <= (float)max_factor ? max((int)ceil(inverse.y), 1) : max_factor;
+    factors[p] = (int4)(m, n, m, n);
+    flags[p] = saturated;
+}

@@ -1,0 +1,116 @@
+/* Stage 4: vertex data of each patch in the pattern's layout (reference.quad_pattern): the
+ * boundary ring first, evaluated canonically from the edge curves so that neighbours agree
+ * bitwise, then the inner grid row by row, by forward differencing or direct evaluation.
+ * Mirror: reference.tessellate.  One work-item per patch. */
+#include "cltess.h"
+
+typedef struct {
+    __global float *positions;   /* (V, 3) */
+    __global float *normals;     /* (V, 3) */
+    __global float *uvs;         /* (V, 2) */
+    __global int *patch_ids;     /* (V,) */
+    __global int *object_ids;    /* (V,) */
+} vertex_out;
+
+inline void put_vertex(vertex_out out, ulong at, float3 position, float3 normal, float2 uv,
+                       int patch, int object)
+{
+    vstore3(position, at, out.positions);
+    vstore3(normal, at, out.normals);
+    vstore2(uv, at, out.uvs);
+    out.patch_ids[at] = patch;
+    out.object_ids[at] = object;
+}
+
+/* Forward differences of a cubic a0 + a1 u + a2 u^2 + a3 u^3 at u = 0, step h (Wallace 1990):
+ * value, first, second, third difference. */
+inline void cubic_differences(float4 a0, float4 a1, float4 a2, float4 a3, float h, float4 d[4])
+{
+    float h2 = h * h, h3 = h2 * h;
+    d[0] = a0;
+    d[1] = a1 * h + a2 * h2 + a3 * h3;
+    d[2] = 2.0f * a2 * h2 + 6.0f * a3 * h3;
+    d[3] = 6.0f * a3 * h3;
+}
+
+/* Power-form coefficients of the cubic Bernstein polynomial with controls c. */
+inline void power_form(const float4 c[4], float4 a[4])
+{
+    a[0] = c[0];
+    a[1] = 3.0f * (c[1] - c[0]);
+    a[2] = 3.0f * (c[2] - 2.0f * c[1] + c[0]);
+    a[3] = c[3] - 3.0f * c[2] + 3.0f * c[1] - c[0];
+}
+
+inline void step_differences(float4 d[4])
+{
+    d[0] += d[1];
+    d[1] += d[2];
+    d[2] += d[3];
+}
+
+__kernel void quad_vertices(__global const float4 *patches, __global const int4 *factors,
+                            __global const ulong *vertex_offsets, __global const int *patch_objects,
+                            uint num_patches, int forward_differencing,
+                            __global float *positions, __global float *normals, __global float *uvs,
+                            __global int *patch_ids, __global int *object_ids)
+{
+    uint p = get_global_id(0);
+    if (p >= num_patches)
+        return;
+    int4 f = factors[p];
+    if (f.s0 <= 0)
+        return;
+    vertex_out out = {positions, normals, uvs, patch_ids, object_ids};
+    int object = patch_objects[p];
+    float4 b[16];
+    load_patch(patches, p, b);
+    ulong at = vertex_offsets[p];
+
+    /* The boundary ring, counter-clockwise from (0, 0). */
+    for (int e = 0; e < 4; ++e) {
+        float4 c[4];
+        edge_controls(b, e, c);
+        int fe = factor_of(f, e);
+        for (int k = 0; k < fe; ++k) {
+            float4 h = boundary_point(c, k, fe);
+            float2 uv = edge_uv(e, k, fe);
+            float4 s, s_u, s_v;
+            surface_eval(b, uv.x, uv.y, &s, &s_u, &s_v);
+            put_vertex(out, at++, h.xyz / h.w, surface_normal(b, uv.x, uv.y, s, s_u, s_v), uv, p, object);
+        }
+    }
+
+    /* The inner grid (i / A, j / B), i = 1..A-1, j = 1..B-1. */
+    int uniform;
+    int2 core = quad_core(f, &uniform);
+    float h = 1.0f / (float)core.x;
+    for (int j = 1; j < core.y; ++j) {
+        float v = (float)j / (float)core.y;
+        /* Along the row v = const, B is a cubic in u with controls c, B_v one with controls d,
+         * and B_u the derivative of B (DESIGN.md section 6). */
+        float4 c[4], d[4], a[4], av[4], s[4], s_u[4], s_v[4];
+        row_controls(b, v, c, d);
+        power_form(c, a);
+        power_form(d, av);
+        cubic_differences(a[0], a[1], a[2], a[3], h, s);
+        cubic_differences(a[1], 2.0f * a[2], 3.0f * a[3], (float4)(0.0f), h, s_u);
+        cubic_differences(av[0], av[1], av[2], av[3], h, s_v);
+        for (int i = 1; i < core.x; ++i) {
+            float u = (float)i / (float)core.x;
+            float4 value, du, dv;
+            if (forward_differencing) {
+                step_differences(s);
+                step_differences(s_u);
+                step_differences(s_v);
+                value = s[0];
+                du = s_u[0];
+                dv = s_v[0];
+            } else {
+                surface_eval(b, u, v, &value, &du, &dv);
+            }
+            put_vertex(out, at++, value.xyz / value.w, surface_normal(b, u, v, value, du, dv),
+                       (float2)(u, v), p, object);
+        }
+    }
+}

@@ -1,0 +1,44 @@
+"""Stage 3 (kernels/counts.cl + pyopencl.scan, Tessellator.stage_counts) against reference.counts."""
+import numpy as np
+import pyopencl.array as cl_array
+
+from cltess import reference
+
+
+def device_offsets(tessellator, factors):
+    vertex_offsets, index_offsets, _ = tessellator.stage_counts(cl_array.to_device(tessellator.queue, factors))
+    return vertex_offsets.get(), index_offsets.get()
+
+
+def random_factors(rng, count, high=70):
+    factors = rng.integers(1, high, size=(count, 4)).astype(np.int32)
+    uniform = rng.random(count) < 0.3
+    factors[uniform, 2], factors[uniform, 3] = factors[uniform, 0], factors[uniform, 1]
+    factors[rng.random(count) < 0.1] = 0
+    factors[rng.random(count) < 0.05] = 1
+    return factors
+
+
+def test_counts_and_offsets_match_reference(tessellator, rng):
+    factors = random_factors(rng, 1500)
+    vertex_offsets, index_offsets = device_offsets(tessellator, factors)
+    vertex_counts, index_counts = reference.counts(factors)
+    assert np.array_equal(vertex_offsets, reference.offsets(vertex_counts))
+    assert np.array_equal(index_offsets, reference.offsets(index_counts))
+
+
+def test_uniform_grid_counts(tessellator):
+    factors = np.array([[1, 1, 1, 1], [4, 3, 4, 3], [64, 64, 64, 64], [0, 0, 0, 0]], np.int32)
+    vertex_offsets, index_offsets = device_offsets(tessellator, factors)
+    assert np.diff(vertex_offsets).tolist() == [4, 20, 65 * 65, 0]
+    assert np.diff(index_offsets).tolist() == [6, 3 * 24, 3 * 2 * 64 * 64, 0]
+
+
+def test_scan_of_a_large_batch(tessellator, rng):
+    """Enough patches for pyopencl.scan to use several work-groups."""
+    factors = rng.integers(1, 8, size=(200_000, 4)).astype(np.int32)
+    factors[:, 2:] = factors[:, :2]
+    vertex_offsets, index_offsets = device_offsets(tessellator, factors)
+    m, n = factors[:, 0].astype(np.int64), factors[:, 1].astype(np.int64)
+    assert np.array_equal(np.diff(vertex_offsets), (m + 1) * (n + 1))
+    assert np.array_equal(np.diff(index_offsets), 6 * m * n)

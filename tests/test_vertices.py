@@ -1,0 +1,66 @@
+"""Stage 4 (kernels/vertices.cl, Tessellator.stage_vertices) against reference.tessellate."""
+import numpy as np
+import pyopencl.array as cl_array
+import pytest
+
+from cltess import reference
+from support import as_float32, random_patches
+from test_counts import random_factors
+
+FD_POSITION_TOLERANCE = 2e-5  # relative to the patch size, forward differencing vs direct
+
+
+def device_vertices(tessellator, patches, factors, forward_differencing):
+    q = tessellator.queue
+    count = len(patches)
+    data = cl_array.to_device(q, patches.reshape(count, 16, 4).astype(np.float32))
+    final = cl_array.to_device(q, factors)
+    objects = cl_array.to_device(q, (np.arange(count) * 7 % 5).astype(np.int32))
+    vertex_offsets, _, _ = tessellator.stage_counts(final)
+    total = int(vertex_offsets[count].get())
+    out, _ = tessellator.stage_vertices(data, final, vertex_offsets, objects, total, forward_differencing)
+    return {k: a.get() for k, a in out.items()}
+
+
+@pytest.mark.parametrize("forward_differencing", [False, True], ids=["direct", "fd"])
+def test_vertices_match_reference_on_random_rational_patches(tessellator, rng, forward_differencing):
+    patches = random_patches(rng, 300, spread=1.0)
+    factors = random_factors(rng, 300, high=40)
+    got = device_vertices(tessellator, patches, factors, forward_differencing)
+    expected = reference.tessellate(as_float32(patches), factors, (np.arange(300) * 7 % 5))
+    assert np.array_equal(got["patch_ids"], expected["patch_ids"])
+    assert np.array_equal(got["object_ids"], expected["object_ids"])
+    assert np.abs(got["uv"] - expected["uv"]).max() < 1e-6
+    scale = np.abs(patches[..., :3] / patches[..., 3:]).max()
+    tolerance = (2e-6 if not forward_differencing else FD_POSITION_TOLERANCE) * scale
+    assert np.abs(got["positions"] - expected["positions"]).max() < tolerance
+    # Normals: unit, and the same direction (cosine) except at rare near-degenerate points.
+    assert np.allclose(np.linalg.norm(got["normals"], axis=1), 1, atol=1e-5)
+    cosine = (got["normals"] * expected["normals"]).sum(1)
+    assert np.quantile(cosine, 0.999) > 1 - 1e-6 and cosine.min() > 0.99
+
+
+def test_forward_differencing_agrees_with_direct_evaluation(tessellator, rng):
+    """The stated tolerance of FD: max position difference / patch size below 2e-5 at factor 64."""
+    patches = random_patches(rng, 200, spread=1.0)
+    factors = np.full((200, 4), 64, np.int32)
+    fd = device_vertices(tessellator, patches, factors, True)
+    direct = device_vertices(tessellator, patches, factors, False)
+    scale = np.abs(patches[..., :3] / patches[..., 3:]).max()
+    difference = np.abs(fd["positions"] - direct["positions"]).max() / scale
+    print(f"forward differencing vs direct at factor 64: {difference:.2e} of the patch size")
+    assert difference < FD_POSITION_TOLERANCE
+    assert np.array_equal(fd["uv"], direct["uv"])
+
+
+def test_boundary_points_are_symmetric_and_corners_exact(tessellator, rng):
+    """A patch and its mirror (u -> 1 - u) walk edge 0 in opposite directions: the points on it
+    must come out bitwise equal, corners included (DESIGN.md section 4)."""
+    patch = random_patches(rng, 1, spread=1.0)[0]
+    mirrored = patch[:, ::-1]
+    for f in (1, 2, 3, 7, 8, 33, 64):
+        out = device_vertices(tessellator, np.stack([patch, mirrored]), np.full((2, 4), f, np.int32), True)
+        ring = out["positions"].reshape(2, -1, 3)[:, :4 * f]
+        assert np.array_equal(ring[0, :f + 1], ring[1, :f + 1][::-1]), f
+        corners = patch[[0, 0, 3, 3], [0, 3, 3, 0]].astype(np.float32)
+        assert np.allclose(ring[0, [0, f, 2 * f, 3 * f]], corners[:, :3] / corners[:, 3:], rtol=1e-6, atol=0)
