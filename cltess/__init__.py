@@ -4,6 +4,7 @@
 >>> tess = Tessellator().tessellate(load_scene("scenes/teapot.bez"), eps=1e-3)
 >>> export(tess, "teapot.ply")
 """
+from .export import export
 from .scene import Camera, Scene, SceneError
 from .tessellation import Tessellation
 
@@ -16,9 +17,6 @@ def __getattr__(name):
     if name == "load_scene":
         from .formats import load_scene
         return load_scene
-    if name == "export":
-        from .export import export
-        return export
     raise AttributeError(name)
 
 

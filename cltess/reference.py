@@ -72,24 +72,45 @@ def zs_factors(patches: np.ndarray, eps: np.ndarray, culled: np.ndarray | None =
 
 
 def zs_inverse_steps(patch: np.ndarray, eps: float) -> tuple[float, float]:
-    """(1/du, 1/dv) maximising du*dv under the ZS bound, for one (4, 4, 4) patch."""
+    """(1/du, 1/dv) maximising du*dv under the error bound, for one (4, 4, 4) patch.
+
+    Zheng-Sederberg for rational patches, in the form that bounds the error at the same (u, v)
+    against the *affine* interpolant l of the samples.  With X = w (P - c) about the box centre
+    c: w (p - l) = X - w l =: F vanishes at the triangle's corners, so
+    |F| <= (1/8)(F_uu du^2 + 2 F_uv du dv + F_vv dv^2) and |p - l| <= |F| / min w, where
+
+        |F_uu| <= |X_uu| + r |w_uu| + 2 |w_u| |l_u|,   |l_u| <= sup |p_u| <= (|X_u| + r |w_u|) / min w
+
+    and likewise F_vv, F_uv (= X_uv - w_uv l - w_u l_v - w_v l_u).  The |X|, |w| derivative
+    bounds come from the control-point differences (6 and 9 for second, 3 for first).  With
+    equal weights the w terms vanish and this is the paper's bound exactly; the paper's
+    ``max(r - eps, 0)`` bounds the distance to the projective interpolant L_X / L_w instead,
+    which is not the same (u, v) when the weights differ (DESIGN.md section 2).
+    """
     points = patch[..., :3] / patch[..., 3:]
     centre = (points.min(axis=(0, 1)) + points.max(axis=(0, 1))) / 2
     w = patch[..., 3]
-    wp = patch[..., :3] - w[..., None] * centre  # translate to the box centre first
+    x = patch[..., :3] - w[..., None] * centre  # translate to the box centre first
     r = np.linalg.norm(points - centre, axis=-1).max()
-    slack = max(r - eps, 0.0)
+    w_min = w.min()
 
-    def bound(d_wp, d_w):
-        return (np.linalg.norm(d_wp, axis=-1) + slack * np.abs(d_w)).max()
+    def norm_max(d):
+        return np.abs(d).max() if d.ndim == 2 else np.linalg.norm(d, axis=-1).max()
 
     # [j, i]: u differences run along axis 1, v differences along axis 0.
-    d_uu = 6 * bound(wp[:, 2:] - 2 * wp[:, 1:-1] + wp[:, :-2], w[:, 2:] - 2 * w[:, 1:-1] + w[:, :-2])
-    d_vv = 6 * bound(wp[2:] - 2 * wp[1:-1] + wp[:-2], w[2:] - 2 * w[1:-1] + w[:-2])
-    d_uv = 9 * bound(wp[1:, 1:] - wp[1:, :-1] - wp[:-1, 1:] + wp[:-1, :-1],
-                     w[1:, 1:] - w[1:, :-1] - w[:-1, 1:] + w[:-1, :-1])
-    c = 8 * eps * w.min()
-    du, dv = zs_steps(d_uu, d_uv, d_vv, c)
+    def second_u(a): return a[:, 2:] - 2 * a[:, 1:-1] + a[:, :-2]
+    def second_v(a): return a[2:] - 2 * a[1:-1] + a[:-2]
+    def mixed(a): return a[1:, 1:] - a[1:, :-1] - a[:-1, 1:] + a[:-1, :-1]
+    def first_u(a): return a[:, 1:] - a[:, :-1]
+    def first_v(a): return a[1:] - a[:-1]
+
+    w_u, w_v = 3 * norm_max(first_u(w)), 3 * norm_max(first_v(w))
+    slope_u = (3 * norm_max(first_u(x)) + r * w_u) / w_min  # bounds |p_u|, hence |l_u|
+    slope_v = (3 * norm_max(first_v(x)) + r * w_v) / w_min
+    d_uu = 6 * norm_max(second_u(x)) + r * 6 * norm_max(second_u(w)) + 2 * w_u * slope_u
+    d_vv = 6 * norm_max(second_v(x)) + r * 6 * norm_max(second_v(w)) + 2 * w_v * slope_v
+    d_uv = 9 * norm_max(mixed(x)) + r * 9 * norm_max(mixed(w)) + w_u * slope_v + w_v * slope_u
+    du, dv = zs_steps(d_uu, d_uv, d_vv, 8 * eps * w_min)
     return 1 / du, 1 / dv
 
 

@@ -57,7 +57,7 @@ __kernel void zs_factors(__global const float4 *patches, uint num_patches, float
         return;
     }
 
-    /* Translate to the box centre: the bound's r = max |P_ij| is not translation-invariant. */
+    /* Translate to the box centre: the bound's r = max |P_ij - c| is not translation-invariant. */
     float3 centre = 0.5f * (lo + hi);
     float4 t[16];
     float r = 0.0f;
@@ -65,23 +65,36 @@ __kernel void zs_factors(__global const float4 *patches, uint num_patches, float
         t[k] = (float4)(b[k].xyz - b[k].w * centre, b[k].w);
         r = max(r, length(b[k].xyz / b[k].w - centre));
     }
-    float slack = max(r - tol, 0.0f);
 
-    /* ||d(wP)|| + max(r - eps, 0) |dw| over the second differences (DESIGN.md section 2). */
-    float d_uu = 0.0f, d_vv = 0.0f, d_uv = 0.0f;
+    /* Maxima of |difference of X| and |difference of w| over the control net
+     * (reference.zs_inverse_steps gives the derivation): .x = X part, .y = w part. */
+    float2 uu = 0.0f, vv = 0.0f, uv = 0.0f, u1 = 0.0f, v1 = 0.0f;
     for (int j = 0; j < 4; ++j)
         for (int i = 0; i < 2; ++i) {
             float4 d = t[4 * j + i + 2] - 2.0f * t[4 * j + i + 1] + t[4 * j + i];
-            d_uu = max(d_uu, length(d.xyz) + slack * fabs(d.w));
+            uu = max(uu, (float2)(length(d.xyz), fabs(d.w)));
             float4 e = t[4 * (i + 2) + j] - 2.0f * t[4 * (i + 1) + j] + t[4 * i + j];
-            d_vv = max(d_vv, length(e.xyz) + slack * fabs(e.w));
+            vv = max(vv, (float2)(length(e.xyz), fabs(e.w)));
         }
     for (int j = 0; j < 3; ++j)
         for (int i = 0; i < 3; ++i) {
             float4 d = t[4 * (j + 1) + i + 1] - t[4 * (j + 1) + i] - t[4 * j + i + 1] + t[4 * j + i];
-            d_uv = max(d_uv, length(d.xyz) + slack * fabs(d.w));
+            uv = max(uv, (float2)(length(d.xyz), fabs(d.w)));
         }
-    float2 step = zs_steps(6.0f * d_uu, 9.0f * d_uv, 6.0f * d_vv, 8.0f * tol * min_w);
+    for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 3; ++i) {
+            float4 d = t[4 * j + i + 1] - t[4 * j + i];
+            u1 = max(u1, (float2)(length(d.xyz), fabs(d.w)));
+            float4 e = t[4 * (i + 1) + j] - t[4 * i + j];
+            v1 = max(v1, (float2)(length(e.xyz), fabs(e.w)));
+        }
+    float w_u = 3.0f * u1.y, w_v = 3.0f * v1.y;
+    float slope_u = (3.0f * u1.x + r * w_u) / min_w;  /* bounds |p_u|, hence |l_u| */
+    float slope_v = (3.0f * v1.x + r * w_v) / min_w;
+    float d_uu = 6.0f * uu.x + r * 6.0f * uu.y + 2.0f * w_u * slope_u;
+    float d_vv = 6.0f * vv.x + r * 6.0f * vv.y + 2.0f * w_v * slope_v;
+    float d_uv = 9.0f * uv.x + r * 9.0f * uv.y + w_u * slope_v + w_v * slope_u;
+    float2 step = zs_steps(d_uu, d_uv, d_vv, 8.0f * tol * min_w);
     float2 inverse = 1.0f / step;
     int saturated = !(inverse.x <= (float)max_factor && inverse.y <= (float)max_factor);
     int m = inverse.x <= (float)max_factor ? max((int)ceil(inverse.x), 1) : max_factor;

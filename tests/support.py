@@ -22,10 +22,10 @@ def as_float32(patches: np.ndarray) -> np.ndarray:
 
 
 def closed_torus_grid(rng: np.random.Generator, patches_u: int, patches_v: int,
-                      noise: float = 0.05, radii=(3.0, 1.0)) -> Scene:
+                      noise: float = 0.05, radii=(3.0, 1.0), weights=(0.5, 2.0)) -> Scene:
     """A closed C0 surface of patches_u x patches_v bicubic patches with random weights.
 
-    One periodic control net of (3 patches_u) x (3 patches_v) points on a torus; neighbouring
+    Weights are drawn uniformly from ``weights``.  One periodic control net of (3 patches_u) x (3 patches_v) points on a torus; neighbouring
     patches share their boundary rows of that net exactly (same floats), as a real model does.
     """
     nu, nv = 3 * patches_u, 3 * patches_v
@@ -35,8 +35,8 @@ def closed_torus_grid(rng: np.random.Generator, patches_u: int, patches_v: int,
     ring = big + small * np.cos(b)[:, None]  # (nv, 1), rows of the net run around the tube
     net = np.stack(np.broadcast_arrays(ring * np.cos(a), ring * np.sin(a), small * np.sin(b)[:, None]), -1)
     net = net + rng.normal(size=net.shape) * noise
-    weights = rng.uniform(0.2, 5.0, size=net.shape[:2])
-    homogeneous = np.concatenate([net * weights[..., None], weights[..., None]], -1)
+    w = rng.uniform(*weights, size=net.shape[:2])
+    homogeneous = np.concatenate([net * w[..., None], w[..., None]], -1)
     patches = [homogeneous[np.ix_((3 * q + np.arange(4)) % nv, (3 * p + np.arange(4)) % nu)]
                for q in range(patches_v) for p in range(patches_u)]
     return Scene(np.array(patches), np.zeros(len(patches), np.int32), name="torus-grid")

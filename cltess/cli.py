@@ -1,0 +1,238 @@
+"""The ``cltess`` command line.
+
+    cltess devices
+    cltess tessellate SCENE (--eps E | --pixels PX) [--no-fd] [--max-factor N]
+                      [--device NAME] [--quiet] -o OUT
+
+Exit codes: 0 success, 1 OpenCL / device failure, 2 usage or input error, 130 interrupted.
+Expected errors print ``cltess: error: <message>`` on stderr, without a traceback, and leave
+no output file behind (exports are atomic).
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+from pathlib import Path
+
+from cltess.export import SUPPORTED_EXTENSIONS, check_extension
+
+PROG = "cltess"
+DEFAULT_MAX_FACTOR = 64
+EXIT_OK, EXIT_DEVICE, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
+
+#: The stats printed on their own summary lines; any other int stat is listed after them.
+_MAIN_STATS = ("patches", "culled", "saturated", "vertices", "triangles")
+
+
+class UsageError(Exception):
+    """Bad arguments or input, reported as ``cltess: error: ...`` with exit code 2."""
+
+    def __init__(self, message: str, usage: str | None = None):
+        super().__init__(message)
+        self.usage = usage
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse that raises UsageError instead of printing and calling sys.exit(2)."""
+
+    def error(self, message):
+        raise UsageError(message, usage=self.format_usage().rstrip())
+
+
+def _positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not math.isfinite(value) or value <= 0:
+        raise argparse.ArgumentTypeError(f"must be a finite number > 0, got {text!r}")
+    return value
+
+
+def _factor(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be >= 1, got {value}")
+    return value
+
+
+def _version() -> str:
+    from importlib import metadata
+
+    try:
+        return metadata.version("cltess")
+    except metadata.PackageNotFoundError:
+        return "(not installed)"
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(
+        prog=PROG,
+        description="Crack-free, error-bounded tessellation of rational bicubic Bezier patches with OpenCL.",
+    )
+    parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
+    commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+
+    commands.add_parser(
+        "devices", help="list OpenCL platforms and devices",
+        description="List OpenCL platforms and devices; '*' marks the default "
+                    "($CLTESS_DEVICE, else the first CPU device).",
+    )
+
+    run = commands.add_parser(
+        "tessellate", help="tessellate a scene and export the mesh",
+        description="Tessellate a scene (.bpt, .bez or .json) and write the mesh "
+                    f"({', '.join(SUPPORTED_EXTENSIONS)}).",
+    )
+    run.add_argument("scene", metavar="SCENE", help="scene file: .bpt, .bez or .json")
+    tolerance = run.add_mutually_exclusive_group(required=True)
+    tolerance.add_argument("--eps", type=_positive_float, metavar="E",
+                           help="object-space tolerance: max distance from surface to mesh")
+    tolerance.add_argument("--pixels", type=_positive_float, metavar="PX",
+                           help="screen-space tolerance in pixels (needs a camera in the scene)")
+    run.add_argument("--no-fd", action="store_true",
+                     help="evaluate every vertex directly instead of by forward differencing")
+    run.add_argument("--max-factor", type=_factor, default=DEFAULT_MAX_FACTOR, metavar="N",
+                     help=f"largest edge factor per patch (default {DEFAULT_MAX_FACTOR})")
+    run.add_argument("--device", metavar="NAME",
+                     help="OpenCL device: substring of platform or device name (default $CLTESS_DEVICE, "
+                          "else the first CPU device)")
+    run.add_argument("-o", "--output", required=True, metavar="OUT",
+                     help=f"output mesh: {', '.join(SUPPORTED_EXTENSIONS)}")
+    run.add_argument("-q", "--quiet", action="store_true", help="print nothing on success (warnings still go to stderr)")
+    return parser
+
+
+# --------------------------------------------------------------------------- commands
+
+
+def cmd_devices(args) -> int:
+    """One line per platform, one per device under it; '*' marks the default device."""
+    from cltess.device import DEVICE_ENV_VAR, DeviceError, default_device_info, list_devices
+
+    devices = list_devices()
+    try:
+        default = default_device_info(devices)
+    except DeviceError:
+        if not devices:
+            raise  # no platform: the install hint
+        print(f"{PROG}: warning: ${DEVICE_ENV_VAR}={os.environ.get(DEVICE_ENV_VAR)!r} matches no device "
+              "below, so there is no default", file=sys.stderr)
+        default = None
+    platform = None
+    for info in devices:
+        if info.platform != platform:
+            platform = info.platform
+            print(f"{info.platform} ({info.platform_vendor}; {info.platform_version})")
+        marker = "*" if default is not None and info.device == default.device else " "
+        memory_gib = info.global_memory_bytes / 2**30
+        print(f"  {marker} {info.name}  [{info.type}]  {info.version}  "
+              f"{info.compute_units} compute units  {memory_gib:.1f} GiB")
+    return EXIT_OK
+
+
+def _check_output_path(path: Path) -> None:
+    check_extension(path)
+    if path.is_dir():
+        raise UsageError(f"{path}: is a directory")
+    if not path.parent.is_dir():
+        raise UsageError(f"{path}: folder {str(path.parent)!r} does not exist")
+
+
+def cmd_tessellate(args) -> int:
+    """Load, tessellate, export, summarise."""
+    from cltess.device import pick_device
+    from cltess.export import export
+    from cltess.formats import load_scene
+
+    output = Path(args.output)
+    _check_output_path(output)
+    scene = load_scene(args.scene)
+    if args.pixels is not None and scene.camera is None:
+        raise UsageError(f"{args.scene}: --pixels needs a camera in the scene (use a .json scene "
+                         "with a \"camera\", or give --eps)")
+    device = pick_device(args.device)
+
+    from cltess.pipeline import Tessellator  # lazy: builds OpenCL programs
+
+    tessellator = Tessellator(device=device)
+    tess = tessellator.tessellate(scene, eps=args.eps, pixels=args.pixels, max_factor=args.max_factor,
+                                  forward_differencing=not args.no_fd)
+    export(tess, output)
+
+    saturated = int(tess.stats.get("saturated", 0))
+    if saturated:
+        patches = "1 patch reaches" if saturated == 1 else f"{saturated} patches reach"
+        verb = "does" if saturated == 1 else "do"
+        print(f"{PROG}: warning: {patches} --max-factor {args.max_factor} and {verb} not meet the error "
+              "bound; raise --max-factor", file=sys.stderr)
+    if not args.quiet:
+        tolerance = f"eps {args.eps:g}" if args.eps is not None else f"{args.pixels:g} px"
+        print(format_summary(tess.stats, tess.stage_ms, scene=args.scene, device=device.name.strip(),
+                             tolerance=tolerance, output=output))
+    return EXIT_OK
+
+
+def format_summary(stats: dict, stage_ms: dict, scene, device: str, tolerance: str, output) -> str:
+    """The tessellate summary: counts, extra int stats, per-stage ms, output path."""
+    rows = [
+        ("scene", f"{scene}  ({tolerance}, device {device})"),
+        ("patches", f"{stats.get('patches', '?')}  (culled {stats.get('culled', '?')}, "
+                    f"saturated {stats.get('saturated', '?')})"),
+        ("vertices", stats.get("vertices", "?")),
+        ("triangles", stats.get("triangles", "?")),
+    ]
+    for name, value in stats.items():
+        if name not in _MAIN_STATS and isinstance(value, int) and not isinstance(value, bool):
+            rows.append((name.replace("_", " "), value))
+    if stage_ms:
+        rows.append(("stage ms", ", ".join(f"{name} {ms:.3f}" for name, ms in stage_ms.items())))
+    rows.append(("wrote", output))
+    width = max(len(label) for label, _ in rows) + 2
+    return "\n".join(f"{label:<{width}}{value}" for label, value in rows)
+
+
+_COMMANDS = {"devices": cmd_devices, "tessellate": cmd_tessellate}
+
+
+# --------------------------------------------------------------------------- entry point
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line; returns the exit code (the console script exits with it)."""
+    import pyopencl as cl
+
+    from cltess.device import DeviceError
+    from cltess.scene import SceneError
+
+    try:
+        args = build_parser().parse_args(argv)
+        return _COMMANDS[args.command](args)
+    except SystemExit as done:  # --help / --version
+        return done.code if isinstance(done.code, int) else EXIT_OK
+    except KeyboardInterrupt:
+        print(f"{PROG}: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except (DeviceError, cl.Error, MemoryError) as error:
+        return _fail(error, EXIT_DEVICE)
+    except UsageError as error:
+        if error.usage:
+            print(error.usage, file=sys.stderr)
+        return _fail(error, EXIT_USAGE)
+    except (SceneError, ValueError) as error:
+        return _fail(error, EXIT_USAGE)
+    except OSError as error:  # unreadable scene, unwritable output
+        message = f"{error.filename}: {error.strerror}" if error.filename and error.strerror else str(error)
+        return _fail(message, EXIT_USAGE)
+    except RuntimeError as error:  # e.g. an OpenCL program that failed to build
+        return _fail(error, EXIT_DEVICE)
+
+
+def _fail(error, code: int) -> int:
+    print(f"{PROG}: error: {error}", file=sys.stderr)
+    return code

@@ -1,0 +1,331 @@
+"""The command line: argument validation, error reporting, exit codes, summary.
+
+Most tests replace ``cltess.pipeline`` with a fake (``fake_pipeline``) so that they check the
+CLI's own behaviour; ``test_tessellate_end_to_end`` runs the real pipeline once.
+"""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import types
+from pathlib import Path
+
+import numpy as np
+import pyopencl as cl
+import pytest
+import trimesh
+
+from cltess import cli
+from cltess.cli import main
+from cltess.device import DEVICE_ENV_VAR
+from cltess.scene import Scene
+from cltess.tessellation import Tessellation
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def flat_patch_bpt(path: Path, bad_line: int | None = None) -> Path:
+    """A one-patch .bpt (a bent unit square); ``bad_line`` (1-based) gets a non-number."""
+    lines = ["1", "3 3"]
+    for j in range(4):
+        for i in range(4):
+            lines.append(f"{i / 3} {j / 3} {0.1 * (i - 1.5) ** 2}")
+    if bad_line is not None:
+        lines[bad_line - 1] = "0.0 zero 0.0"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+@pytest.fixture(autouse=True)
+def no_device_env(monkeypatch):
+    monkeypatch.delenv(DEVICE_ENV_VAR, raising=False)
+
+
+@pytest.fixture
+def scene_file(tmp_path) -> Path:
+    return flat_patch_bpt(tmp_path / "patch.bpt")
+
+
+def small_tessellation(stats_extra: dict | None = None, saturated: int = 0) -> Tessellation:
+    positions = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], np.float32)
+    return Tessellation(
+        positions=positions, normals=np.tile(np.float32([0, 0, 1]), (4, 1)), uv=positions[:, :2].copy(),
+        patch_ids=np.zeros(4, np.int32), object_ids=np.zeros(4, np.int32),
+        triangles=np.array([[0, 1, 2], [1, 3, 2]], np.uint32), factors=np.ones((1, 4), np.int32),
+        stage_ms={"factors": 0.5, "indices": 0.25},
+        stats={"patches": 1, "culled": 0, "saturated": saturated, "vertices": 4, "triangles": 2,
+               **(stats_extra or {})},
+    )
+
+
+class FakeTessellator:
+    """Stands in for cltess.pipeline.Tessellator; records its calls."""
+
+    calls: list = []
+    result: Tessellation | BaseException = small_tessellation()
+
+    def __init__(self, device=None):
+        self.device = device
+
+    def tessellate(self, scene, eps=None, pixels=None, max_factor=64, forward_differencing=True):
+        FakeTessellator.calls.append(dict(scene=scene, eps=eps, pixels=pixels, max_factor=max_factor,
+                                          forward_differencing=forward_differencing, device=self.device))
+        if isinstance(FakeTessellator.result, BaseException):
+            raise FakeTessellator.result
+        return FakeTessellator.result
+
+
+@pytest.fixture
+def fake_pipeline(monkeypatch):
+    module = types.ModuleType("cltess.pipeline")
+    module.Tessellator = FakeTessellator
+    monkeypatch.setitem(sys.modules, "cltess.pipeline", module)
+    monkeypatch.setattr(FakeTessellator, "calls", [])
+    monkeypatch.setattr(FakeTessellator, "result", small_tessellation())
+    return FakeTessellator
+
+
+def run(capsys, *argv) -> tuple[int, str, str]:
+    code = main([str(a) for a in argv])
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def assert_clean_error(err: str, *fragments: str) -> None:
+    assert "cltess: error:" in err
+    assert "Traceback" not in err
+    for fragment in fragments:
+        assert fragment in err
+
+
+# --------------------------------------------------------------------------- devices
+
+
+def test_devices_lists_pocl_with_default_marker(capsys):
+    code, out, err = run(capsys, "devices")
+    assert code == 0 and err == ""
+    assert "Portable Computing Language" in out
+    device_lines = [line for line in out.splitlines() if line.startswith("  ")]
+    assert sum(line.lstrip().startswith("*") for line in device_lines) == 1
+    assert "CPU" in out
+
+
+def test_devices_without_platform_exits_1_with_install_hint(capsys, monkeypatch):
+    monkeypatch.setattr(cl, "get_platforms", lambda: [])
+    code, out, err = run(capsys, "devices")
+    assert code == 1
+    assert_clean_error(err, "pip install")
+
+
+def test_devices_with_unmatched_env_var_still_lists(capsys, monkeypatch):
+    monkeypatch.setenv(DEVICE_ENV_VAR, "no-such-device")
+    code, out, err = run(capsys, "devices")
+    assert code == 0
+    assert "Portable Computing Language" in out and "*" not in out
+    assert "warning" in err and "no-such-device" in err
+
+
+# --------------------------------------------------------------------------- argument validation
+
+
+@pytest.mark.parametrize("arguments, fragment", [
+    (["--eps", "0"], "--eps"),
+    (["--eps", "-1e-3"], "--eps"),
+    (["--eps", "nan"], "--eps"),
+    (["--eps", "inf"], "--eps"),
+    (["--eps", "abc"], "--eps"),
+    (["--pixels", "0"], "--pixels"),
+    (["--pixels", "-inf"], "--pixels"),
+    (["--eps", "1e-3", "--max-factor", "0"], "--max-factor"),
+    (["--eps", "1e-3", "--max-factor", "2.5"], "--max-factor"),
+    (["--eps", "1e-3", "--pixels", "1"], "not allowed"),
+    ([], "--eps"),
+])
+def test_bad_arguments_exit_2_before_any_work(capsys, tmp_path, scene_file, fake_pipeline, arguments, fragment):
+    out_path = tmp_path / "out.ply"
+    code, out, err = run(capsys, "tessellate", scene_file, *arguments, "-o", out_path)
+    assert code == 2
+    assert_clean_error(err, fragment)
+    assert "usage:" in err
+    assert not out_path.exists()
+    assert fake_pipeline.calls == []
+
+
+def test_missing_output_option_exits_2(capsys, scene_file, fake_pipeline):
+    code, _, err = run(capsys, "tessellate", scene_file, "--eps", "1e-3")
+    assert code == 2
+    assert_clean_error(err, "-o")
+
+
+def test_unknown_output_extension_checked_before_loading(capsys, tmp_path, monkeypatch, fake_pipeline):
+    import cltess.formats
+
+    def must_not_load(path):
+        raise AssertionError("scene loaded before the output path was checked")
+
+    monkeypatch.setattr(cltess.formats, "load_scene", must_not_load)
+    code, _, err = run(capsys, "tessellate", tmp_path / "any.bpt", "--eps", "1e-3", "-o", tmp_path / "out.stl")
+    assert code == 2
+    assert_clean_error(err, ".stl", ".ply")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_output_in_missing_folder_exits_2(capsys, tmp_path, scene_file, fake_pipeline):
+    code, _, err = run(capsys, "tessellate", scene_file, "--eps", "1e-3", "-o", tmp_path / "nowhere" / "out.ply")
+    assert code == 2
+    assert_clean_error(err, "does not exist")
+    assert fake_pipeline.calls == []
+
+
+def test_no_command_exits_2(capsys):
+    code, _, err = run(capsys)
+    assert code == 2
+    assert_clean_error(err)
+
+
+def test_help_exits_0(capsys):
+    code, out, _ = run(capsys, "tessellate", "--help")
+    assert code == 0
+    assert "--max-factor" in out and "--pixels" in out
+
+
+# --------------------------------------------------------------------------- bad scenes (cltess.formats)
+
+
+def test_bad_scene_line_exits_2_naming_file_and_line(capsys, tmp_path, fake_pipeline):
+    bad = flat_patch_bpt(tmp_path / "bad.bpt", bad_line=5)
+    out_path = tmp_path / "out.ply"
+    code, _, err = run(capsys, "tessellate", bad, "--eps", "1e-3", "-o", out_path)
+    assert code == 2
+    assert_clean_error(err, "bad.bpt", "line 5")
+    assert not out_path.exists()
+    assert fake_pipeline.calls == []
+
+
+def test_truncated_scene_exits_2(capsys, tmp_path, fake_pipeline):
+    truncated = tmp_path / "short.bpt"
+    truncated.write_text("2\n3 3\n0 0 0\n")
+    code, _, err = run(capsys, "tessellate", truncated, "--eps", "1e-3", "-o", tmp_path / "out.ply")
+    assert code == 2
+    assert_clean_error(err, "short.bpt")
+
+
+def test_missing_scene_file_exits_2(capsys, tmp_path, fake_pipeline):
+    code, _, err = run(capsys, "tessellate", tmp_path / "absent.bez", "--eps", "1e-3", "-o", tmp_path / "o.ply")
+    assert code == 2
+    assert_clean_error(err, "absent.bez")
+
+
+def test_pixels_without_camera_exits_2(capsys, tmp_path, scene_file, fake_pipeline):
+    out_path = tmp_path / "out.ply"
+    code, _, err = run(capsys, "tessellate", scene_file, "--pixels", "0.5", "-o", out_path)
+    assert code == 2
+    assert_clean_error(err, "camera")
+    assert not out_path.exists()
+    assert fake_pipeline.calls == []
+
+
+# --------------------------------------------------------------------------- tessellate (fake pipeline)
+
+
+def test_tessellate_passes_options_and_prints_summary(capsys, tmp_path, scene_file, fake_pipeline):
+    fake_pipeline.result = small_tessellation(stats_extra={"shared_edges": 7, "note": "not an int"})
+    out_path = tmp_path / "mesh.ply"
+    code, out, err = run(capsys, "tessellate", scene_file, "--eps", "2e-3", "--no-fd", "--max-factor", "16",
+                         "--device", "pocl", "-o", out_path)
+    assert code == 0, err
+    assert err == ""
+    (call,) = fake_pipeline.calls
+    assert isinstance(call["scene"], Scene) and call["scene"].num_patches == 1
+    assert call["eps"] == 2e-3 and call["pixels"] is None
+    assert call["max_factor"] == 16 and call["forward_differencing"] is False
+    assert isinstance(call["device"], cl.Device)
+    for fragment in ("patches", "culled", "saturated", "vertices", "triangles", "shared edges", "7",
+                     "factors 0.500", "indices 0.250", str(out_path)):
+        assert fragment in out
+    assert "not an int" not in out
+    mesh = trimesh.load(out_path, process=False)
+    assert mesh.faces.shape == (2, 3)
+
+
+def test_defaults(capsys, tmp_path, scene_file, fake_pipeline):
+    code, _, _ = run(capsys, "tessellate", scene_file, "--eps", "1e-3", "-o", tmp_path / "m.npz")
+    assert code == 0
+    (call,) = fake_pipeline.calls
+    assert call["max_factor"] == 64 and call["forward_differencing"] is True
+    assert (tmp_path / "m.npz").exists()
+
+
+def test_saturated_patches_warn_even_when_quiet(capsys, tmp_path, scene_file, fake_pipeline):
+    fake_pipeline.result = small_tessellation(saturated=3)
+    code, out, err = run(capsys, "tessellate", scene_file, "--eps", "1e-3", "--quiet", "-o", tmp_path / "m.obj")
+    assert code == 0
+    assert out == ""
+    assert "warning" in err and "3 patches" in err and "--max-factor" in err
+
+
+@pytest.mark.parametrize("failure, code, fragment", [
+    (ValueError("the scene has no patches"), 2, "no patches"),
+    (cl.RuntimeError("clEnqueueNDRangeKernel failed: OUT_OF_RESOURCES"), 1, "OUT_OF_RESOURCES"),
+    (RuntimeError("kernels/factors.cl failed to build"), 1, "failed to build"),
+    (MemoryError("too many vertices"), 1, "too many vertices"),
+])
+def test_pipeline_errors_map_to_exit_codes(capsys, tmp_path, scene_file, fake_pipeline, failure, code, fragment):
+    fake_pipeline.result = failure
+    out_path = tmp_path / "out.ply"
+    result, _, err = run(capsys, "tessellate", scene_file, "--eps", "1e-3", "-o", out_path)
+    assert result == code
+    assert_clean_error(err, fragment)
+    assert list(tmp_path.iterdir()) == [scene_file]
+
+
+def test_unknown_device_exits_1_listing_devices(capsys, tmp_path, scene_file, fake_pipeline):
+    code, _, err = run(capsys, "tessellate", scene_file, "--eps", "1e-3", "--device", "no-such-gpu",
+                       "-o", tmp_path / "out.ply")
+    assert code == 1
+    assert_clean_error(err, "no-such-gpu", "available devices")
+    assert fake_pipeline.calls == []
+
+
+def test_interrupt_during_export_leaves_no_file(capsys, tmp_path, scene_file, fake_pipeline, monkeypatch):
+    def interrupted(fd):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(os, "fsync", interrupted)
+    out_path = tmp_path / "out.ply"
+    code, _, err = run(capsys, "tessellate", scene_file, "--eps", "1e-3", "-o", out_path)
+    assert code == 130
+    assert "interrupted" in err
+    assert list(tmp_path.iterdir()) == [scene_file]
+
+
+# --------------------------------------------------------------------------- real pipeline, module entry
+
+
+def test_tessellate_end_to_end(capsys, tmp_path, scene_file):
+    """The real pipeline on one patch (needs cltess.pipeline and the kernels)."""
+    out_path = tmp_path / "patch.ply"
+    code, out, err = run(capsys, "tessellate", scene_file, "--eps", "1e-3", "-o", out_path)
+    assert code == 0, err
+    mesh = trimesh.load(out_path, process=False)
+    assert len(mesh.faces) > 2
+    summary = dict(line.split(None, 1) for line in out.splitlines())
+    assert int(summary["triangles"]) == len(mesh.faces)
+    assert int(summary["vertices"]) == len(mesh.vertices)
+    assert summary["wrote"] == str(out_path)
+
+
+def test_python_dash_m_runs(tmp_path):
+    result = subprocess.run([sys.executable, "-m", "cltess", "--version"], cwd=REPO,
+                            capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0
+    assert result.stdout.startswith("cltess ")
+
+
+def test_console_script_points_at_main():
+    import tomllib
+
+    scripts = tomllib.loads((REPO / "pyproject.toml").read_text())["project"]["scripts"]
+    module, function = scripts["cltess"].split(":")
+    assert (module, function) == ("cltess.cli", "main") and cli.main is main
