@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
@@ -95,12 +96,30 @@ class Tessellator:
         Exactly one of ``eps`` (object-space tolerance) and ``pixels`` (screen-space tolerance,
         needs ``scene.camera``) must be given.
         """
+        plan = self.plan(scene, eps=eps, pixels=pixels, max_factor=max_factor)
+        return self.emit(plan, 0, plan.num_patches, forward_differencing)
+
+    def tessellate_in_batches(self, scene: Scene, max_output_bytes: int, eps: float | None = None,
+                              pixels: float | None = None, max_factor: int = DEFAULT_MAX_FACTOR,
+                              forward_differencing: bool = True):
+        """(plan, iterator of Tessellation batches) whose outputs each fit ``max_output_bytes``.
+
+        Stages 1-3 run once for the whole scene (so factors are crack-free across batches);
+        stages 4-5 run per batch of consecutive patches.  Batch triangles number the vertices
+        globally, so concatenating the batches gives exactly the single-pass result.
+        """
+        plan = self.plan(scene, eps=eps, pixels=pixels, max_factor=max_factor)
+        ranges = plan.batch_ranges(max_output_bytes)
+        return plan, (self.emit(plan, first, last, forward_differencing) for first, last in ranges)
+
+    def plan(self, scene: Scene, eps: float | None = None, pixels: float | None = None,
+             max_factor: int = DEFAULT_MAX_FACTOR) -> "Plan":
+        """Stages 1-3 for the whole scene: final factors and offsets, left on the device."""
         _check_tolerance(scene, eps, pixels, max_factor)
         started = time.perf_counter()
-        queue = self.queue
         count = scene.num_patches
-        patches = cl_array.to_device(queue, scene.patches.reshape(count, 16, 4).astype(np.float32))
-        patch_objects = cl_array.to_device(queue, scene.object_ids)
+        patches = cl_array.to_device(self.queue, scene.patches.reshape(count, 16, 4).astype(np.float32))
+        objects = cl_array.to_device(self.queue, scene.object_ids)
         events = {}
         camera = scene.camera if pixels is not None else None
         factors, flags, events["factors"] = self.stage_factors(patches, eps, pixels, camera, max_factor)
@@ -110,15 +129,9 @@ class Tessellator:
         num_vertices = int(vertex_offsets[count].get())  # the two read-backs
         num_indices = int(index_offsets[count].get())
         if num_vertices >= 2**32:
-            raise MemoryError(f"{scene.name}: {num_vertices} vertices do not fit 32-bit indices")
-        vertices, events["vertices"] = self.stage_vertices(
-            patches, final, vertex_offsets, patch_objects, num_vertices, forward_differencing)
-        triangles, events["indices"] = self.stage_indices(final, vertex_offsets, index_offsets, num_indices)
-        queue.finish()
-
+            raise MemoryError(f"{scene.name}: {num_vertices} vertices do not fit 32-bit indices; "
+                              "raise the tolerance or lower --max-factor")
         flag_values = flags.get()
-        stage_ms = {stage: _span_ms(evs) for stage, evs in events.items() if evs}
-        stage_ms["total_wall"] = (time.perf_counter() - started) * 1e3
         stats = {
             "patches": count,
             "culled": int(np.count_nonzero(flag_values & 2)),
@@ -129,8 +142,25 @@ class Tessellator:
             "boundary_edges": groups.boundary,
             "nonmanifold_edges": groups.nonmanifold,
         }
-        return Tessellation(triangles=triangles.get(), factors=final.get(), stage_ms=stage_ms,
-                            stats=stats, **{k: a.get() for k, a in vertices.items()})
+        return Plan(scene.name, count, patches, objects, final, vertex_offsets, index_offsets,
+                    num_vertices, num_indices, stats, events, started)
+
+    def emit(self, plan: "Plan", first: int, last: int, forward_differencing: bool = True) -> Tessellation:
+        """Stages 4-5 for patches ``first .. last-1`` of a plan, read back to the host."""
+        vertex_range = plan.vertex_range(first, last)
+        index_range = plan.index_range(first, last)
+        events = dict(plan.events) if first == 0 else {}
+        vertices, events["vertices"] = self.stage_vertices(
+            plan.patches, plan.factors, plan.vertex_offsets, plan.objects, vertex_range,
+            (first, last), forward_differencing)
+        triangles, events["indices"] = self.stage_indices(
+            plan.factors, plan.vertex_offsets, plan.index_offsets, index_range, (first, last))
+        self.queue.finish()
+        stage_ms = {stage: _span_ms(evs) for stage, evs in events.items() if evs}
+        stage_ms["total_wall"] = (time.perf_counter() - plan.started) * 1e3
+        stats = dict(plan.stats, first_patch=first, last_patch=last)
+        return Tessellation(triangles=triangles.get(), factors=plan.host_factors()[first:last],
+                            stage_ms=stage_ms, stats=stats, **{k: a.get() for k, a in vertices.items()})
 
     # --- the stages: device arrays in, device arrays and their events out ----------------------
 
@@ -172,11 +202,12 @@ class Tessellator:
             self.programs.offsets_scan(index_counts, index_offsets)]
         return vertex_offsets, index_offsets, events
 
-    def stage_vertices(self, patches, factors, vertex_offsets, patch_objects, num_vertices,
-                       forward_differencing=True):
-        """Stage 4 -> dict of positions (V, 3), normals (V, 3), uv (V, 2), patch_ids (V,),
-        object_ids (V,) device arrays."""
-        q, n = self.queue, num_vertices
+    def stage_vertices(self, patches, factors, vertex_offsets, patch_objects, vertex_range,
+                       patch_range, forward_differencing=True):
+        """Stage 4 for patches patch_range = (first, last), whose vertices are vertex_range =
+        (start, stop) -> dict of positions (V, 3), normals (V, 3), uv (V, 2), patch_ids (V,),
+        object_ids (V,) device arrays, V = stop - start."""
+        q, n = self.queue, vertex_range[1] - vertex_range[0]
         out = {"positions": cl_array.empty(q, (n, 3), np.float32),
                "normals": cl_array.empty(q, (n, 3), np.float32),
                "uv": cl_array.empty(q, (n, 2), np.float32),
@@ -184,23 +215,98 @@ class Tessellator:
                "object_ids": cl_array.empty(q, n, np.int32)}
         if not n:
             return out, []
-        count = len(factors)
+        first, last = patch_range
         event = self.programs.quad_vertices(
-            q, _global_size(count), None, patches.data, factors.data, vertex_offsets.data,
-            patch_objects.data, np.uint32(count), np.int32(forward_differencing),
-            *(a.data for a in out.values()))
+            q, _global_size(last - first), None, patches.data, factors.data, vertex_offsets.data,
+            patch_objects.data, np.uint32(first), np.uint32(last - first), np.uint64(vertex_range[0]),
+            np.int32(forward_differencing), *(a.data for a in out.values()))
         return out, [event]
 
-    def stage_indices(self, factors, vertex_offsets, index_offsets, num_indices):
-        """Stage 5 -> triangles (T, 3) uint32 device array."""
-        triangles = cl_array.empty(self.queue, (num_indices // 3, 3), np.uint32)
-        if not num_indices:
+    def stage_indices(self, factors, vertex_offsets, index_offsets, index_range, patch_range):
+        """Stage 5 for patches patch_range = (first, last), whose indices are index_range =
+        (start, stop) -> triangles ((stop - start) / 3, 3) uint32 device array."""
+        n = index_range[1] - index_range[0]
+        triangles = cl_array.empty(self.queue, (n // 3, 3), np.uint32)
+        if not n:
             return triangles, []
-        count = len(factors)
+        first, last = patch_range
         event = self.programs.quad_indices(
-            self.queue, _global_size(count), None, factors.data, vertex_offsets.data,
-            index_offsets.data, np.uint32(count), triangles.data)
+            self.queue, _global_size(last - first), None, factors.data, vertex_offsets.data,
+            index_offsets.data, np.uint32(first), np.uint32(last - first), np.uint64(index_range[0]),
+            triangles.data)
         return triangles, [event]
+
+
+BYTES_PER_VERTEX = 3 * 4 + 3 * 4 + 2 * 4 + 4 + 4  # position, normal, uv, patch id, object id
+BYTES_PER_INDEX = 4
+
+
+@dataclass
+class Plan:
+    """Stages 1-3 done for a whole scene: what stages 4-5 need, on the device.
+
+    factors: (P, 4) final factors; vertex_offsets, index_offsets: (P+1,) exclusive scans with
+    the totals last; stats: the scene's counts (see Tessellation.stats).
+    """
+
+    name: str
+    num_patches: int
+    patches: cl_array.Array
+    objects: cl_array.Array
+    factors: cl_array.Array
+    vertex_offsets: cl_array.Array
+    index_offsets: cl_array.Array
+    num_vertices: int
+    num_indices: int
+    stats: dict
+    events: dict
+    started: float
+    _host: dict = field(default_factory=dict)
+
+    def host_factors(self) -> np.ndarray:
+        if "factors" not in self._host:
+            self._host["factors"] = self.factors.get()
+        return self._host["factors"]
+
+    def _offsets(self, which: str) -> np.ndarray:
+        if which not in self._host:  # read back only when a range is asked of a partial batch
+            self._host[which] = getattr(self, which).get()
+        return self._host[which]
+
+    def vertex_range(self, first: int, last: int) -> tuple[int, int]:
+        if (first, last) == (0, self.num_patches):
+            return 0, self.num_vertices
+        offsets = self._offsets("vertex_offsets")
+        return int(offsets[first]), int(offsets[last])
+
+    def index_range(self, first: int, last: int) -> tuple[int, int]:
+        if (first, last) == (0, self.num_patches):
+            return 0, self.num_indices
+        offsets = self._offsets("index_offsets")
+        return int(offsets[first]), int(offsets[last])
+
+    @property
+    def output_bytes(self) -> int:
+        return self.num_vertices * BYTES_PER_VERTEX + self.num_indices * BYTES_PER_INDEX
+
+    def batch_ranges(self, max_output_bytes: int) -> list[tuple[int, int]]:
+        """Consecutive patch ranges whose vertex + index output fits max_output_bytes each."""
+        if self.output_bytes <= max_output_bytes:
+            return [(0, self.num_patches)]
+        size = (self._offsets("vertex_offsets") * BYTES_PER_VERTEX
+                + self._offsets("index_offsets") * BYTES_PER_INDEX).astype(np.int64)
+        per_patch = np.diff(size)
+        if per_patch.max() > max_output_bytes:
+            worst = int(per_patch.argmax())
+            raise MemoryError(f"{self.name}: patch {worst} alone needs {per_patch[worst]} bytes of output, "
+                              f"more than the cap of {max_output_bytes}; lower max_factor or raise the cap")
+        ranges, first = [], 0
+        while first < self.num_patches:
+            last = int(np.searchsorted(size, size[first] + max_output_bytes, side="right")) - 1
+            last = max(min(last, self.num_patches), first + 1)
+            ranges.append((first, last))
+            first = last
+        return ranges
 
 
 def _check_tolerance(scene: Scene, eps, pixels, max_factor) -> None:

@@ -2,12 +2,14 @@
  * One work-item per patch. */
 #include "cltess.h"
 
+/* Patches first_patch .. first_patch + num_patches - 1 (one batch); their indices go to
+ * index_offsets[p] - index_base and number the vertices globally (vertex_offsets[p]). */
 __kernel void quad_indices(__global const int4 *factors, __global const ulong *vertex_offsets,
-                           __global const ulong *index_offsets, uint num_patches,
-                           __global uint *indices)
+                           __global const ulong *index_offsets, uint first_patch, uint num_patches,
+                           ulong index_base, __global uint *indices)
 {
-    uint p = get_global_id(0);
-    if (p >= num_patches)
+    if (get_global_id(0) >= num_patches)
         return;
-    quad_triangles(factors[p], indices + index_offsets[p], (uint)vertex_offsets[p]);
+    uint p = first_patch + (uint)get_global_id(0);
+    quad_triangles(factors[p], indices + (index_offsets[p] - index_base), (uint)vertex_offsets[p]);
 }

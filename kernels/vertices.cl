@@ -49,15 +49,18 @@ inline void step_differences(float4 d[4])
     d[2] += d[3];
 }
 
+/* Patches first_patch .. first_patch + num_patches - 1 (one batch); their vertices go to
+ * vertex_offsets[p] - vertex_base of the output arrays. */
 __kernel void quad_vertices(__global const float4 *patches, __global const int4 *factors,
                             __global const ulong *vertex_offsets, __global const int *patch_objects,
-                            uint num_patches, int forward_differencing,
+                            uint first_patch, uint num_patches, ulong vertex_base,
+                            int forward_differencing,
                             __global float *positions, __global float *normals, __global float *uvs,
                             __global int *patch_ids, __global int *object_ids)
 {
-    uint p = get_global_id(0);
-    if (p >= num_patches)
+    if (get_global_id(0) >= num_patches)
         return;
+    uint p = first_patch + (uint)get_global_id(0);
     int4 f = factors[p];
     if (f.s0 <= 0)
         return;
@@ -65,7 +68,7 @@ __kernel void quad_vertices(__global const float4 *patches, __global const int4 
     int object = patch_objects[p];
     float4 b[16];
     load_patch(patches, p, b);
-    ulong at = vertex_offsets[p];
+    ulong at = vertex_offsets[p] - vertex_base;
 
     /* The boundary ring, counter-clockwise from (0, 0). */
     for (int e = 0; e < 4; ++e) {

@@ -12,8 +12,8 @@ from test_counts import random_factors
 def device_triangles(tessellator, factors):
     final = cl_array.to_device(tessellator.queue, factors)
     vertex_offsets, index_offsets, _ = tessellator.stage_counts(final)
-    triangles, _ = tessellator.stage_indices(final, vertex_offsets, index_offsets,
-                                             int(index_offsets[len(factors)].get()))
+    total = int(index_offsets[len(factors)].get())
+    triangles, _ = tessellator.stage_indices(final, vertex_offsets, index_offsets, (0, total), (0, len(factors)))
     return triangles.get(), vertex_offsets.get()
 
 

@@ -18,7 +18,8 @@ def device_vertices(tessellator, patches, factors, forward_differencing):
     objects = cl_array.to_device(q, (np.arange(count) * 7 % 5).astype(np.int32))
     vertex_offsets, _, _ = tessellator.stage_counts(final)
     total = int(vertex_offsets[count].get())
-    out, _ = tessellator.stage_vertices(data, final, vertex_offsets, objects, total, forward_differencing)
+    out, _ = tessellator.stage_vertices(data, final, vertex_offsets, objects, (0, total), (0, count),
+                                       forward_differencing)
     return {k: a.get() for k, a in out.items()}
 
 
