@@ -1,7 +1,7 @@
 """The ``cltess`` command line.
 
     cltess devices
-    cltess tessellate SCENE (--eps E | --pixels PX) [--no-fd] [--max-factor N]
+    cltess tessellate SCENE (--eps E | --pixels PX) [--no-fd] [--max-factor N] [--max-memory SIZE]
                       [--device NAME] [--quiet] -o OUT
 
 Exit codes: 0 success, 1 OpenCL / device failure, 2 usage or input error, 130 interrupted.
@@ -61,6 +61,15 @@ def _factor(text: str) -> int:
     return value
 
 
+def _memory_size(text: str) -> int:
+    from cltess.stream import parse_size
+
+    try:
+        return parse_size(text)
+    except (ValueError, IndexError):
+        raise argparse.ArgumentTypeError(f"not a memory size like 512M or 2G: {text!r}") from None
+
+
 def _version() -> str:
     from importlib import metadata
 
@@ -102,6 +111,10 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--device", metavar="NAME",
                      help="OpenCL device: substring of platform or device name (default $CLTESS_DEVICE, "
                           "else the first CPU device)")
+    run.add_argument("--max-memory", type=_memory_size, metavar="SIZE",
+                     help="cap on the memory the output may take at once (e.g. 512M, 2G); a larger "
+                          "output is tessellated in batches streamed to the file (.ply, .obj). "
+                          "Default: half the device's memory")
     run.add_argument("-o", "--output", required=True, metavar="OUT",
                      help=f"output mesh: {', '.join(SUPPORTED_EXTENSIONS)}")
     run.add_argument("-q", "--quiet", action="store_true", help="print nothing on success (warnings still go to stderr)")
@@ -147,8 +160,8 @@ def _check_output_path(path: Path) -> None:
 def cmd_tessellate(args) -> int:
     """Load, tessellate, export, summarise."""
     from cltess.device import pick_device
-    from cltess.export import export
     from cltess.formats import load_scene
+    from cltess.stream import tessellate_to_file
 
     output = Path(args.output)
     _check_output_path(output)
@@ -161,9 +174,11 @@ def cmd_tessellate(args) -> int:
     from cltess.pipeline import Tessellator  # lazy: builds OpenCL programs
 
     tessellator = Tessellator(device=device)
-    tess = tessellator.tessellate(scene, eps=args.eps, pixels=args.pixels, max_factor=args.max_factor,
-                                  forward_differencing=not args.no_fd)
-    export(tess, output)
+    tess = tessellate_to_file(tessellator, scene, output, max_memory_bytes=args.max_memory, eps=args.eps,
+                              pixels=args.pixels, max_factor=args.max_factor,
+                              forward_differencing=not args.no_fd)
+    if tess.batches > 1:
+        tess.stats["batches"] = tess.batches
 
     saturated = int(tess.stats.get("saturated", 0))
     if saturated:

@@ -1,0 +1,109 @@
+"""Tessellate a scene straight into a file, in batches that fit a memory budget.
+
+Stages 1-3 run once for the whole scene (``Tessellator.plan``): the scan tells the output size
+before anything big is allocated.  The patches are then cut into consecutive batches whose
+output fits the budget; each batch runs stages 4-5 (``Tessellator.emit``) and is appended to a
+streaming PLY or OBJ writer.  The file is the same, byte for byte, as a single pass would
+write, and it appears only when complete (``export.atomic_write``).
+
+Memory: a batch's output lives three times at once at most (the device buffers, their host
+copy, the writer's records), so batches are sized to a third of the budget; on a CPU device the
+"device" buffers are host memory too.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pyopencl as cl
+
+from .export import ObjWriter, PlyWriter, check_extension, export
+
+COPIES_IN_FLIGHT = 3  # device buffers, host copy, writer records
+STREAMING_WRITERS = {".ply": PlyWriter, ".obj": ObjWriter}
+
+
+@dataclass
+class StreamResult:
+    """What a streamed run did: the scene's stats, summed stage times, the batches it took."""
+
+    stats: dict
+    stage_ms: dict
+    batches: int
+    budget_bytes: int
+    path: Path
+    batch_ranges: list = field(default_factory=list)
+
+
+def default_budget(device: cl.Device) -> int:
+    """Bytes of output a run may hold at once: half the device's memory, and no single
+    buffer above the device's largest allocation."""
+    return int(min(device.global_mem_size // 2, COPIES_IN_FLIGHT * device.max_mem_alloc_size))
+
+
+def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = None,
+                       **options) -> StreamResult:
+    """Tessellate ``scene`` into ``path`` (.ply, .obj or .npz) within ``max_memory_bytes``.
+
+    options: eps / pixels / max_factor / forward_differencing, as for ``Tessellator.tessellate``.
+    A .npz file cannot be streamed: it must fit the budget in one batch.
+    """
+    path = Path(path)
+    extension = check_extension(path)
+    budget = max_memory_bytes or default_budget(tessellator.device)
+    forward_differencing = options.pop("forward_differencing", True)
+    plan = tessellator.plan(scene, **options)
+    ranges = plan.batch_ranges(max(budget // COPIES_IN_FLIGHT, 1))
+    if extension not in STREAMING_WRITERS:
+        if len(ranges) > 1:
+            raise MemoryError(f"{path}: the output ({plan.output_bytes} bytes) needs {len(ranges)} batches "
+                              f"under a budget of {budget} bytes, and {extension} cannot be streamed; "
+                              "write .ply or .obj, or raise the memory cap")
+        tess = tessellator.emit(plan, 0, plan.num_patches, forward_differencing)
+        export(tess, path)
+        return StreamResult(tess.stats, tess.stage_ms, 1, budget, path, ranges)
+
+    stage_ms: dict = {}
+    done = []
+    with STREAMING_WRITERS[extension](path, plan.num_vertices, plan.num_indices // 3) as writer:
+        for first, last in ranges:
+            for batch in _emit_fitting(tessellator, plan, first, last, forward_differencing):
+                writer.write_vertices(batch)
+                writer.write_faces(batch.triangles)
+                done.append((batch.stats["first_patch"], batch.stats["last_patch"]))
+                for stage, ms in batch.stage_ms.items():
+                    stage_ms[stage] = ms if stage == "total_wall" else stage_ms.get(stage, 0.0) + ms
+                del batch
+    return StreamResult(dict(plan.stats), stage_ms, len(done), budget, path, done)
+
+
+def _emit_fitting(tessellator, plan, first: int, last: int, forward_differencing: bool):
+    """Emit patches first..last-1; if the device runs out of memory, retry in two halves."""
+    try:
+        yield tessellator.emit(plan, first, last, forward_differencing)
+    except (cl.MemoryError, cl.RuntimeError) as error:
+        if not _out_of_memory(error) or last - first == 1:
+            raise
+        middle = (first + last) // 2
+        yield from _emit_fitting(tessellator, plan, first, middle, forward_differencing)
+        yield from _emit_fitting(tessellator, plan, middle, last, forward_differencing)
+
+
+def _out_of_memory(error: Exception) -> bool:
+    text = str(error).upper()
+    return isinstance(error, cl.MemoryError) or "MEM_OBJECT_ALLOCATION_FAILURE" in text \
+        or "OUT_OF_RESOURCES" in text or "OUT_OF_HOST_MEMORY" in text
+
+
+def parse_size(text: str) -> int:
+    """'512M', '16MB', '2G', '1000000' -> bytes (binary units)."""
+    units = {"K": 2**10, "M": 2**20, "G": 2**30}
+    value = text.strip().upper().removesuffix("B").removesuffix("I")
+    scale = units.get(value[-1:], 1)
+    number = float(value[:-1] if value[-1:] in units else value)
+    if not (number > 0 and number * scale < 2**63):
+        raise ValueError(f"memory size must be positive, got {text!r}")
+    return int(number * scale)
+
+
+__all__ = ["StreamResult", "default_budget", "tessellate_to_file", "parse_size"]

@@ -1,0 +1,109 @@
+"""Memory bound (cltess/stream.py): a scene whose output is several times the cap streams to a
+file identical to the single-pass output, and peak memory stays within the cap plus a stated
+overhead (issue 5)."""
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from cltess.formats import load_scene
+from cltess.stream import parse_size, tessellate_to_file
+
+SCENES = Path(__file__).resolve().parent.parent / "scenes"
+MiB = 2**20
+# Peak RSS above a tiny run of the same command (imports, OpenCL runtime, programs): the cap,
+# plus this much for the plan, allocator slack and the writer's buffers (measured: 31 MiB).
+STATED_OVERHEAD = 40 * MiB
+
+PEAK_RSS = """
+import resource, sys
+from cltess.cli import main
+code = main(["tessellate"] + sys.argv[1:] + ["-q"])
+print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024)
+sys.exit(code)
+"""
+
+
+def peak_rss(*args) -> int:
+    done = subprocess.run([sys.executable, "-c", PEAK_RSS, *map(str, args)], capture_output=True, text=True,
+                          timeout=300)
+    assert done.returncode == 0, done.stderr
+    return int(done.stdout.split()[-1])
+
+
+def test_streaming_under_a_16mb_cap_matches_single_pass_and_bounds_memory(tmp_path):
+    cap = 16 * MiB
+    scene = SCENES / "teapots.json"
+    options = ["--eps", "0.0005", "--max-factor", "128"]
+    baseline = peak_rss(SCENES / "teapot.bez", "--eps", "0.1", "-o", tmp_path / "tiny.ply")
+    streamed = peak_rss(scene, *options, "--max-memory", "16M", "-o", tmp_path / "streamed.ply")
+    single = peak_rss(scene, *options, "-o", tmp_path / "single.ply")
+    size = (tmp_path / "streamed.ply").stat().st_size
+    print(f"output {size / MiB:.0f} MiB; peak RSS above a tiny run: streamed "
+          f"{(streamed - baseline) / MiB:.1f} MiB under a 16 MiB cap, single pass {(single - baseline) / MiB:.1f} MiB")
+    assert size >= 8 * cap
+    assert (tmp_path / "streamed.ply").read_bytes() == (tmp_path / "single.ply").read_bytes()
+    assert streamed - baseline <= cap + STATED_OVERHEAD
+    assert single - baseline > 2 * (cap + STATED_OVERHEAD)  # the cap is what made the difference
+
+
+@pytest.mark.parametrize("suffix", [".ply", ".obj"])
+def test_streamed_files_equal_single_pass_files(tessellator, tmp_path, suffix):
+    """PLY: byte-identical.  OBJ: the same mesh (its v/vt/vn lines come batch by batch, which
+    OBJ allows: each kind is numbered in order of appearance)."""
+    import trimesh
+
+    scene = load_scene(SCENES / "teapot.bez")
+    streamed = tessellate_to_file(tessellator, scene, tmp_path / f"a{suffix}", max_memory_bytes=900_000, eps=0.002)
+    single = tessellate_to_file(tessellator, scene, tmp_path / f"b{suffix}", eps=0.002)
+    assert streamed.batches > 3 and single.batches == 1
+    assert streamed.stats == single.stats
+    if suffix == ".ply":
+        assert (tmp_path / "a.ply").read_bytes() == (tmp_path / "b.ply").read_bytes()
+    else:
+        a, b = (trimesh.load(tmp_path / name, process=False, maintain_order=True) for name in ("a.obj", "b.obj"))
+        assert (a.vertices == b.vertices).all() and (a.faces == b.faces).all()
+        assert (a.vertex_normals == b.vertex_normals).all()
+
+
+def test_npz_that_does_not_fit_is_refused_before_writing(tessellator, tmp_path):
+    scene = load_scene(SCENES / "teapot.bez")
+    with pytest.raises(MemoryError, match="cannot be streamed"):
+        tessellate_to_file(tessellator, scene, tmp_path / "out.npz", max_memory_bytes=900_000, eps=0.002)
+    assert not any(tmp_path.iterdir())
+
+
+def test_out_of_memory_on_the_device_retries_smaller_batches(tessellator, tmp_path, monkeypatch):
+    """A batch that fails with an allocation error is split in halves, never hangs or dies."""
+    import pyopencl as cl
+
+    scene = load_scene(SCENES / "teapot.bez")
+    real_emit = tessellator.emit
+    failed = []
+
+    def emit(plan, first, last, forward_differencing=True):
+        if last - first > 4:
+            failed.append((first, last))
+            raise cl.MemoryError("clEnqueueNDRangeKernel", cl.status_code.MEM_OBJECT_ALLOCATION_FAILURE,
+                                 "simulated")
+        return real_emit(plan, first, last, forward_differencing)
+
+    monkeypatch.setattr(tessellator, "emit", emit)
+    result = tessellate_to_file(tessellator, scene, tmp_path / "a.ply", eps=0.01)
+    monkeypatch.undo()
+    tessellate_to_file(tessellator, scene, tmp_path / "b.ply", eps=0.01)
+    assert failed and result.batches >= 8
+    assert (tmp_path / "a.ply").read_bytes() == (tmp_path / "b.ply").read_bytes()
+
+
+@pytest.mark.parametrize("text, size", [("16M", 16 * MiB), ("512MB", 512 * MiB), ("2G", 2 * 2**30),
+                                        ("1000", 1000), ("1.5K", 1536), ("4MiB", 4 * MiB)])
+def test_parse_size(text, size):
+    assert parse_size(text) == size
+
+
+@pytest.mark.parametrize("text", ["0", "-1M", "lots", "M"])
+def test_parse_size_refuses_nonsense(text):
+    with pytest.raises((ValueError, IndexError)):
+        parse_size(text)
