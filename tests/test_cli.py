@@ -69,11 +69,33 @@ class FakeTessellator:
         self.device = device
 
     def tessellate(self, scene, eps=None, pixels=None, max_factor=64, forward_differencing=True):
+        return self.emit(self.plan(scene, eps, pixels, max_factor), 0, 1, forward_differencing)
+
+    # The CLI streams through cltess.stream, which calls plan() once and emit() per batch.
+    def plan(self, scene, eps=None, pixels=None, max_factor=64):
         FakeTessellator.calls.append(dict(scene=scene, eps=eps, pixels=pixels, max_factor=max_factor,
-                                          forward_differencing=forward_differencing, device=self.device))
+                                          device=self.device))
         if isinstance(FakeTessellator.result, BaseException):
             raise FakeTessellator.result
-        return FakeTessellator.result
+        return FakePlan(FakeTessellator.result)
+
+    def emit(self, plan, first, last, forward_differencing=True):
+        FakeTessellator.calls[-1]["forward_differencing"] = forward_differencing
+        result = FakeTessellator.result
+        result.stats.update(first_patch=first, last_patch=last)
+        return result
+
+
+class FakePlan:
+    """One batch holding the whole fake result."""
+
+    def __init__(self, tess):
+        self.stats, self.num_patches = dict(tess.stats), 1
+        self.num_vertices, self.num_indices = tess.num_vertices, 3 * tess.num_triangles
+        self.output_bytes = 0
+
+    def batch_ranges(self, max_output_bytes):
+        return [(0, 1)]
 
 
 @pytest.fixture
