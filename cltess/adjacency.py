@@ -1,35 +1,46 @@
-"""Patch-edge adjacency from shared boundary control points (DESIGN.md section 4).
+"""Patch-edge adjacency (DESIGN.md section 4): Bézier patches by shared boundary control points,
+PN triangles by shared welded vertex positions.
 
-Two patch edges are the same edge when their four homogeneous boundary control points
+Two Bézier patch edges are the same edge when their four homogeneous boundary control points
 (``cltess.scene.boundary_curves``, edge ``e`` of patch ``p`` is patch-edge ``4 p + e``) are
 exactly equal, in the same or the reversed order.  Exact float equality is what makes shared
 boundary vertices bitwise identical; -0.0 and 0.0 count as equal.  A collapsed edge (its four
 control points at one Cartesian position, e.g. the teapot lid's centre or a sphere's pole) is
 never grouped.  Edges shared by more than two patches, or a patch glued to itself, are scene
 facts counted in the stats, not errors.
+
+Two triangle edges (edge ``e`` of triangle ``t``, from corner ``e`` to ``e+1``, is patch-edge
+``3 t + e``) are the same edge when their end points are at bitwise the same float32 positions
+(``cltess.scene.weld_positions``), either way round, so meshes split along UV seams still
+connect.  Their PN boundary curves then agree exactly when the normals at the two ends do too;
+where they differ the edge is *sharp* and ``pn_edge_normals`` decides the curve both sides use.
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 
-from .scene import boundary_curves
+from .scene import boundary_curves, weld_positions
 
-__all__ = ["EdgeGroups", "edge_groups"]
+__all__ = ["EdgeGroups", "edge_groups", "mesh_edge_groups", "pn_edge_normals", "merge_edge_groups",
+           "SHARP_EDGE_MODES"]
 
 
 @dataclass
 class EdgeGroups:
-    """Patch-edges grouped into shared edges (P patches, G groups).
+    """Patch-edges grouped into shared edges (P patches of E edges each, G groups).
 
-    group_of:    (4P,) int32, the group of patch-edge ``4 p + e``.
-    group_start: (G+1,) int32 and members: (4P,) int32, CSR: the patch-edges of group g are
+    group_of:    (EP,) int32, the group of patch-edge ``E p + e`` (E = 4 for Bézier patches,
+                 3 for triangles).
+    group_start: (G+1,) int32 and members: (EP,) int32, CSR: the patch-edges of group g are
                  ``members[group_start[g]:group_start[g+1]]`` (ascending).  Every patch-edge
-                 is in exactly one group, so ``members`` is a permutation of ``0..4P-1``.
+                 is in exactly one group, so ``members`` is a permutation of ``0..EP-1``.
                  Groups are numbered in order of their first patch-edge.
-    flipped:     (4P,) bool, True where the patch-edge runs against its group's canonical
-                 direction (the lexicographically smaller of its two point orders).
+    flipped:     (EP,) bool, True where the patch-edge runs against its group's canonical
+                 direction (Bézier: the lexicographically smaller of its two point orders;
+                 triangles: from the smaller welded vertex number to the larger).
     shared:      groups of exactly two patch-edges.
     boundary:    singleton groups that are not collapsed (open boundary).
     collapsed:   collapsed patch-edges (each a singleton group).
@@ -110,16 +121,24 @@ def edge_groups(patches: np.ndarray) -> EdgeGroups:
     # Group equal canonical rows: hash to 64 bits, group by hash, verify bit equality.
     # Collapsed edges get groups of their own (never grouped).
     open_edges = np.flatnonzero(~collapsed)
-    closed_edges = np.flatnonzero(collapsed)
     bits = canonical[open_edges].view(np.uint64)  # (n, 16): equal floats <=> equal bits
     _, first_open, inverse = np.unique(_hash_rows(bits), return_index=True, return_inverse=True)
     inverse = inverse.ravel()
     if not np.array_equal(bits, bits[first_open][inverse]):  # a hash collision: sort the bytes
         keys = np.ascontiguousarray(bits).view(np.dtype((np.void, 16 * 8))).ravel()
-        _, first_open, inverse = np.unique(keys, return_index=True, return_inverse=True)
-        inverse = inverse.ravel()
+        _, inverse = np.unique(keys, return_inverse=True)
+    return _grouped(inverse.ravel(), collapsed, flipped, palindrome, edges_per_patch=4)
+
+
+def _grouped(labels: np.ndarray, collapsed: np.ndarray, flipped: np.ndarray, palindrome: np.ndarray,
+             edges_per_patch: int) -> EdgeGroups:
+    """EdgeGroups from a group label per open (not collapsed) patch-edge, in order."""
+    num_edges = len(collapsed)
+    open_edges = np.flatnonzero(~collapsed)
+    closed_edges = np.flatnonzero(collapsed)
+    _, first_open, inverse = np.unique(labels, return_index=True, return_inverse=True)
     raw = np.empty(num_edges, np.int64)
-    raw[open_edges] = inverse
+    raw[open_edges] = inverse.ravel()
     raw[closed_edges] = len(first_open) + np.arange(len(closed_edges))
     first = np.concatenate([open_edges[first_open], closed_edges])  # first patch-edge per raw group
     # Renumber groups by their first patch-edge.
@@ -133,7 +152,7 @@ def edge_groups(patches: np.ndarray) -> EdgeGroups:
 
     # Stats.  Members of a group are ascending, so two edges of one patch sit side by side.
     same_group = group_of[members[1:]] == group_of[members[:-1]]
-    same_patch = members[1:] // 4 == members[:-1] // 4
+    same_patch = members[1:] // edges_per_patch == members[:-1] // edges_per_patch
     self_glued = len(np.unique(group_of[members[1:]][same_group & same_patch]))
     pair_starts = group_start[:-1][sizes == 2]
     a, b = members[pair_starts], members[pair_starts + 1]
@@ -153,6 +172,104 @@ def edge_groups(patches: np.ndarray) -> EdgeGroups:
         self_glued=int(self_glued),
         reversed_pairs=reversed_pairs,
     )
+
+
+def merge_edge_groups(parts, num_patches: int, slots: int = 4) -> EdgeGroups:
+    """The edge groups of several patch kinds as groups over one (P, slots) factor array.
+
+    parts: (groups, edges per patch, base) per kind: its patch-edge ``E p + e`` becomes entry
+    ``slots (base + p) + e``.  Entries a kind leaves unused become collapsed singletons (their
+    factor stays 0).  Kinds never share edges.  The counts are the sums of the parts'.
+    """
+    total = slots * num_patches
+    if len(parts) == 1 and parts[0][1] == slots and parts[0][2] == 0 and len(parts[0][0].group_of) == total:
+        return parts[0][0]
+    labels = np.full(total, -1, np.int64)
+    flipped = np.zeros(total, bool)
+    offset = 0
+    for groups, edges, base in parts:
+        count = len(groups.group_of) // edges
+        entries = (slots * (base + np.arange(count))[:, None] + np.arange(edges)).reshape(-1)
+        labels[entries] = groups.group_of + offset
+        flipped[entries] = groups.flipped
+        offset += groups.num_groups
+    unused = labels < 0
+    merged = _grouped(labels[~unused], unused, flipped, unused, slots)
+    counts = {name: sum(getattr(groups, name) for groups, _, _ in parts)
+              for name in ("shared", "boundary", "collapsed", "nonmanifold", "self_glued", "reversed_pairs")}
+    return dataclasses.replace(merged, **counts)
+
+
+# --------------------------------------------------------------------------- triangle meshes
+
+#: How ``pn_edge_normals`` treats a sharp edge (different normals on its two sides).
+SHARP_EDGE_MODES = ("straight", "average", "keep")
+
+
+def mesh_edge_groups(corners: np.ndarray, normals: np.ndarray | None = None) -> tuple[EdgeGroups, np.ndarray]:
+    """Group the edges of triangles by welded corner positions.
+
+    corners: (T, 3, 3) corner positions, normals: (T, 3, 3) the corners' normals, both as the
+    device sees them (float32).  Patch-edge ``3 t + e`` runs from corner e to corner e+1; it is
+    ``flipped`` when it runs from the larger welded vertex number to the smaller.  An edge whose
+    two ends weld together is collapsed, and so are all three edges of a folded triangle (two
+    corners at one point, reference.pn_folded: it has no output, its other two edges are one
+    edge): they are never grouped.  Returns (groups, sharp (3T,) bool):
+    sharp where the edge's group holds patch-edges whose normals at the same end differ
+    (bitwise), i.e. whose PN boundary curves differ.
+    """
+    corners = np.asarray(corners, np.float32)
+    count = len(corners)
+    welded = weld_positions(corners.reshape(-1, 3)).reshape(count, 3).astype(np.int64)
+    start, end = welded.reshape(-1), np.roll(welded, -1, axis=1).reshape(-1)
+    collapsed = np.repeat((start == end).reshape(count, 3).any(axis=1), 3)
+    flipped = start > end
+    low, high = np.minimum(start, end), np.maximum(start, end)
+    labels = (low * (int(welded.max()) + 1) + high)[~collapsed]
+    groups = _grouped(labels, collapsed, flipped, collapsed.copy(), edges_per_patch=3)
+    sharp = np.zeros(3 * count, bool)
+    if normals is not None:
+        normals = np.asarray(normals, np.float32) + np.float32(0.0)
+        at_start, at_end = normals.reshape(-1, 3), np.roll(normals, -1, axis=1).reshape(-1, 3)
+        # The normals at the low and the high welded end, as raw bits.
+        ends = np.where(flipped[:, None], np.hstack([at_end, at_start]), np.hstack([at_start, at_end]))
+        bits = np.ascontiguousarray(ends).view(np.uint32)
+        first = groups.members[groups.group_start[:-1]][groups.group_of]  # first member per edge
+        differs = (bits != bits[first]).any(axis=1)
+        sharp_group = np.zeros(groups.num_groups, bool)
+        np.logical_or.at(sharp_group, groups.group_of, differs)
+        sharp = sharp_group[groups.group_of]
+    return groups, sharp
+
+
+def pn_edge_normals(normals: np.ndarray, groups: EdgeGroups, sharp: np.ndarray, mode: str = "straight") -> np.ndarray:
+    """The normals each triangle edge's PN boundary curve uses at its two ends: (T, 3, 2, 3) float32,
+    ``[t, e, 0]`` at corner e, ``[t, e, 1]`` at corner e+1.
+
+    Smooth edges use the corners' vertex normals.  Sharp edges (``mesh_edge_groups``), by mode:
+    ``"straight"`` zero normals, so the boundary curve is the straight edge on every side
+    (watertight, the crease stays a straight line); ``"average"`` at each end the normalised
+    mean of the sides' normals there, the same on every side (watertight, a curved crease);
+    ``"keep"`` each side's own normals, as plain PN triangles do (the surface may crack there).
+    """
+    if mode not in SHARP_EDGE_MODES:
+        raise ValueError(f"sharp_edges must be one of {', '.join(SHARP_EDGE_MODES)}, got {mode!r}")
+    normals = np.asarray(normals, np.float32)
+    out = np.stack([normals, np.roll(normals, -1, axis=1)], axis=2)  # (T, 3, 2, 3)
+    flat = out.reshape(-1, 2, 3)
+    if mode == "straight":
+        flat[sharp] = 0.0
+    elif mode == "average" and sharp.any():
+        flipped = groups.flipped
+        # Per group, the sum of the normals at its low and its high end (float64), then unit.
+        low_high = np.where(flipped[:, None, None], flat[:, ::-1], flat).astype(np.float64)
+        total = np.zeros((groups.num_groups, 2, 3))
+        np.add.at(total, groups.group_of[sharp], low_high[sharp])
+        length = np.linalg.norm(total, axis=2, keepdims=True)
+        mean = np.where(length > 0, total / np.where(length > 0, length, 1.0), 0.0).astype(np.float32)
+        own = mean[groups.group_of[sharp]]
+        flat[sharp] = np.where(flipped[sharp][:, None, None], own[:, ::-1], own)
+    return out
 
 
 def _hash_rows(bits: np.ndarray) -> np.ndarray:

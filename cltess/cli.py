@@ -2,7 +2,8 @@
 
     cltess devices
     cltess tessellate SCENE (--eps E | --pixels PX) [--no-fd] [--max-factor N] [--max-memory SIZE]
-                      [--device NAME] [--quiet] -o OUT
+                      [--sharp-edges {straight,average,keep}] [--device NAME] [--quiet] -o OUT
+    cltess bench [SCENES...] [--device NAME] [--repeat N] [--warmup N] [--no-baseline] [--json OUT]
 
 Exit codes: 0 success, 1 OpenCL / device failure, 2 usage or input error, 130 interrupted.
 Expected errors print ``cltess: error: <message>`` on stderr, without a traceback, and leave
@@ -95,10 +96,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     run = commands.add_parser(
         "tessellate", help="tessellate a scene and export the mesh",
-        description="Tessellate a scene (.bpt, .bez or .json) and write the mesh "
+        description="Tessellate a scene (.bpt, .bez or .json, or a triangle mesh as PN triangles: "
+                    ".obj, .ply, .stl, .off, .glb, .gltf) and write the mesh "
                     f"({', '.join(SUPPORTED_EXTENSIONS)}).",
     )
-    run.add_argument("scene", metavar="SCENE", help="scene file: .bpt, .bez or .json")
+    run.add_argument("scene", metavar="SCENE", help="scene file: .bpt, .bez, .json or a triangle mesh")
     tolerance = run.add_mutually_exclusive_group(required=True)
     tolerance.add_argument("--eps", type=_positive_float, metavar="E",
                            help="object-space tolerance: max distance from surface to mesh")
@@ -115,9 +117,28 @@ def build_parser() -> argparse.ArgumentParser:
                      help="cap on the memory the output may take at once (e.g. 512M, 2G); a larger "
                           "output is tessellated in batches streamed to the file (.ply, .obj). "
                           "Default: half the device's memory")
+    run.add_argument("--sharp-edges", choices=("straight", "average", "keep"), default="straight",
+                     help="meshes: an edge whose two sides have different vertex normals becomes a "
+                          "straight crease (default), a curve from the averaged normals, or keeps "
+                          "each side's own PN curve (may crack)")
     run.add_argument("-o", "--output", required=True, metavar="OUT",
                      help=f"output mesh: {', '.join(SUPPORTED_EXTENSIONS)}")
     run.add_argument("-q", "--quiet", action="store_true", help="print nothing on success (warnings still go to stderr)")
+
+    bench = commands.add_parser(
+        "bench", help="benchmark suite: the CudaTess paper's Tables 1 and 2 on one device",
+        description="Generate the benchmark scenes (0.5 px, 1024x768, a camera each), time every "
+                    "stage on one OpenCL device and print the paper-style tables (cltess.bench).",
+    )
+    bench.add_argument("scenes", nargs="*", metavar="SCENES",
+                       help="scene keys or groups (all, bezier, pn, small); default all")
+    bench.add_argument("--device", metavar="NAME", help="OpenCL device, as for tessellate")
+    bench.add_argument("--repeat", type=_factor, default=3, metavar="N",
+                       help="timed runs per scene and variant; the median is reported (default 3)")
+    bench.add_argument("--warmup", type=int, default=1, metavar="N", help="untimed runs first (default 1)")
+    bench.add_argument("--no-baseline", action="store_true", help="skip the NumPy evaluation baseline")
+    bench.add_argument("--json", metavar="OUT", help="also write every measurement to this JSON file")
+    bench.add_argument("-q", "--quiet", action="store_true", help="no progress lines on stderr")
     return parser
 
 
@@ -174,9 +195,10 @@ def cmd_tessellate(args) -> int:
     from cltess.pipeline import Tessellator  # lazy: builds OpenCL programs
 
     tessellator = Tessellator(device=device)
+    mesh_options = {"sharp_edges": args.sharp_edges} if scene.meshes else {}
     tess = tessellate_to_file(tessellator, scene, output, max_memory_bytes=args.max_memory, eps=args.eps,
                               pixels=args.pixels, max_factor=args.max_factor,
-                              forward_differencing=not args.no_fd)
+                              forward_differencing=not args.no_fd, **mesh_options)
     if tess.batches > 1:
         tess.stats["batches"] = tess.batches
 
@@ -186,6 +208,11 @@ def cmd_tessellate(args) -> int:
         verb = "does" if saturated == 1 else "do"
         print(f"{PROG}: warning: {patches} --max-factor {args.max_factor} and {verb} not meet the error "
               "bound; raise --max-factor", file=sys.stderr)
+    sharp = int(tess.stats.get("sharp_edges", 0))
+    if sharp and args.sharp_edges == "keep":
+        print(f"{PROG}: warning: {sharp} sharp mesh edge{'s' if sharp > 1 else ''} keep each side's own PN "
+              "curve, so the mesh may crack there; --sharp-edges straight or average keeps it closed",
+              file=sys.stderr)
     if not args.quiet:
         tolerance = f"eps {args.eps:g}" if args.eps is not None else f"{args.pixels:g} px"
         print(format_summary(tess.stats, tess.stage_ms, scene=args.scene, device=device.name.strip(),
@@ -212,7 +239,31 @@ def format_summary(stats: dict, stage_ms: dict, scene, device: str, tolerance: s
     return "\n".join(f"{label:<{width}}{value}" for label, value in rows)
 
 
-_COMMANDS = {"devices": cmd_devices, "tessellate": cmd_tessellate}
+def cmd_bench(args) -> int:
+    """Run the benchmark suite on one device and print its tables (cltess.bench)."""
+    from cltess import bench
+    from cltess.device import pick_device
+
+    try:
+        bench.resolve_scenes(args.scenes)
+    except ValueError as error:
+        raise UsageError(str(error)) from None
+    if args.warmup < 0:
+        raise UsageError(f"--warmup must be >= 0, got {args.warmup}")
+    if args.json and not Path(args.json).parent.is_dir():
+        raise UsageError(f"{args.json}: folder {str(Path(args.json).parent)!r} does not exist")
+    device = pick_device(args.device)
+    command = " ".join([PROG, "bench", *sys.argv[2:]]) if sys.argv[1:2] == ["bench"] else None
+    record = bench.run_suite(args.scenes, device=device, repeat=args.repeat, warmup=args.warmup,
+                             progress=bench.Progress(enabled=not args.quiet),
+                             numpy_baseline=not args.no_baseline, command=command)
+    print(bench.format_tables(record))
+    if args.json:
+        bench.write_json(record, args.json)
+    return EXIT_OK
+
+
+_COMMANDS = {"devices": cmd_devices, "tessellate": cmd_tessellate, "bench": cmd_bench}
 
 
 # --------------------------------------------------------------------------- entry point

@@ -34,10 +34,11 @@ _DEVICE_TYPE_NAMES = (
 
 
 def _device_type_name(device_type: int) -> str:
-    for flag, name in _DEVICE_TYPE_NAMES:
-        if device_type & flag:
-            return name
-    return "other"
+    """"CPU", "GPU" or "accelerator"; "other" for none of them, or for a device that claims
+    several (the Oclgrind simulator says CPU | GPU | ACCELERATOR: it must not be taken for a
+    GPU by ``--device gpu``, nor for the default CPU device)."""
+    names = [name for flag, name in _DEVICE_TYPE_NAMES if device_type & flag]
+    return names[0] if len(names) == 1 else "other"
 
 
 @dataclass(frozen=True)

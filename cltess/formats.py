@@ -10,7 +10,11 @@ Three formats, chosen by extension (``load_scene``):
            ``x,y,z`` (or ``x,y,z,w``) line per vertex.
 ``.json``  a scene: ``{"objects": [{"file", "transform", "object_id"}], "camera": {...}}``;
            ``file`` is relative to the JSON file's folder, ``transform`` a row-major 4x4
-           applied to homogeneous control points (``b' = M b``).
+           applied to homogeneous control points (``b' = M b``).  An object file may also be
+           a triangle mesh (below); its transform must be affine.
+
+Triangle meshes (PN triangles): ``.obj``, ``.ply``, ``.stl``, ``.off``, ``.glb``, ``.gltf``,
+read through trimesh (``cltess.meshes``).
 
 Every problem raises :class:`SceneError` naming the file and the 1-based line, the 0-based
 patch (as in ``patch_ids``) or the JSON key at fault.  Header counts are checked against the
@@ -22,11 +26,13 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import re
 from pathlib import Path
 
 import numpy as np
 
+from .meshes import MESH_EXTENSIONS, read_mesh, read_mesh_scene
 from .scene import Camera, Scene, SceneError
 
 __all__ = ["load_scene", "read_bpt", "read_bez", "read_json_scene", "write_bpt", "write_bez"]
@@ -44,11 +50,12 @@ _INT32_MAX = 2**31 - 1
 
 
 def load_scene(path) -> Scene:
-    """Read a ``.bpt``, ``.bez`` or ``.json`` scene; ``Scene.name`` is ``path`` as given."""
+    """Read a ``.bpt``, ``.bez``, ``.json`` or mesh scene; ``Scene.name`` is ``path`` as given."""
     ext = Path(path).suffix.lower()
     reader = _READERS.get(ext)
     if reader is None:
-        raise SceneError(f"{path}: unknown scene extension {ext or '(none)'!r}; expected .bpt, .bez or .json")
+        raise SceneError(f"{path}: unknown scene extension {ext or '(none)'!r}; expected .bpt, .bez, .json "
+                         f"or a triangle mesh ({', '.join(MESH_EXTENSIONS)})")
     return reader(path)
 
 
@@ -124,6 +131,7 @@ def _read_text(path) -> str:
     except UnicodeDecodeError as exc:
         line = data[: exc.start].count(b"\n") + 1
         raise SceneError(f"{path}: line {line}: not UTF-8 text (byte {exc.start})") from None
+    text = text.removeprefix("\ufeff")  # a byte-order mark, as some Windows editors write
     if not text.strip():
         raise SceneError(f"{path}: empty file")
     return text
@@ -280,6 +288,10 @@ def read_json_scene(path) -> Scene:
     except _JsonProblem as exc:
         at = f" line {_line_of(text, exc.token)}:" if exc.token else ""
         raise SceneError(f"{name}:{at} {exc}") from None
+    except ValueError as exc:  # e.g. an integer of more than sys.get_int_max_str_digits() digits
+        raise SceneError(f"{name}: not usable JSON: {exc}") from None
+    except RecursionError:  # arrays or objects nested thousands deep
+        raise SceneError(f"{name}: not usable JSON: nested too deeply") from None
 
     where = _Where(name)
     _check_keys(doc, where, required={"objects"}, optional={"camera"})
@@ -289,7 +301,8 @@ def read_json_scene(path) -> Scene:
 
     folder = Path(path).parent
     cache: dict[Path, np.ndarray] = {}  # one parse per file within this load
-    all_patches, all_ids = [], []
+    all_patches, all_ids, meshes = [], [], []
+    instanced_bytes = 0  # what the instances will take once copied: checked before each copy
     for k, obj in enumerate(objects):
         key = f"objects[{k}]"
         _check_keys(obj, where, required={"file"}, optional={"transform", "object_id"}, key=key)
@@ -297,8 +310,9 @@ def read_json_scene(path) -> Scene:
         if not isinstance(file, str) or not file:
             raise where.error(f"{key}.file", "must be a non-empty string (a path relative to the scene file)")
         ext = Path(file).suffix.lower()
-        if ext not in (".bpt", ".bez"):
-            raise where.error(f"{key}.file", f"{file!r}: object files must be .bpt or .bez, not {ext or '(none)'!r}")
+        if ext not in (".bpt", ".bez") + MESH_EXTENSIONS:
+            raise where.error(f"{key}.file", f"{file!r}: object files must be .bpt, .bez or a triangle mesh "
+                              f"({', '.join(MESH_EXTENSIONS)}), not {ext or '(none)'!r}")
         object_id = obj.get("object_id", k)
         if not _is_int(object_id) or not 0 <= object_id <= _INT32_MAX:
             raise where.error(f"{key}.object_id", f"must be an integer in 0..{_INT32_MAX}, got {object_id!r}")
@@ -306,20 +320,51 @@ def read_json_scene(path) -> Scene:
         resolved = file_path.resolve()
         if resolved not in cache:
             try:
-                lines = _Lines.read(file_path)
-                cache[resolved] = _parse_bpt(lines) if ext == ".bpt" else _parse_bez(lines)
+                if ext in MESH_EXTENSIONS:
+                    cache[resolved] = read_mesh(file_path)
+                else:
+                    lines = _Lines.read(file_path)
+                    cache[resolved] = _parse_bpt(lines) if ext == ".bpt" else _parse_bez(lines)
             except SceneError as exc:
                 raise where.error(f"{key}.file", str(exc)) from None
+        source = cache[resolved]
+        instanced_bytes += source.patches.nbytes if isinstance(source, Scene) else (
+            source.nbytes if isinstance(source, np.ndarray) else
+            source.vertices.nbytes + source.faces.nbytes + 2 * source.vertices.nbytes)
+        if instanced_bytes > _MAX_SCENE_BYTES:
+            raise where.error(key, f"the objects up to here already take {instanced_bytes / 2**30:.1f} GiB "
+                              f"once instanced, more than half of this machine's memory "
+                              f"({_MAX_SCENE_BYTES / 2**30:.1f} GiB)")
+        if ext in MESH_EXTENSIONS:
+            matrix = _transform(obj["transform"], where, f"{key}.transform") if "transform" in obj else np.eye(4)
+            try:
+                meshes.append(cache[resolved].transformed(matrix, object_id))
+            except ValueError as exc:
+                raise where.error(f"{key}.transform", str(exc)) from None
+            continue
         patches = cache[resolved]
         if "transform" in obj:
             matrix = _transform(obj["transform"], where, f"{key}.transform")
-            patches = patches @ matrix.T  # b' = M b for every homogeneous control point
+            with np.errstate(over="ignore", invalid="ignore"):  # reported just below
+                patches = patches @ matrix.T  # b' = M b for every homogeneous control point
             _check_transformed(patches, where, f"{key}.transform")
         all_patches.append(patches)
         all_ids.append(np.full(len(patches), object_id, np.int32))
 
     camera = _camera(doc["camera"], where) if "camera" in doc else None
-    return Scene(np.concatenate(all_patches), np.concatenate(all_ids), camera, name)
+    if not all_patches:
+        all_patches, all_ids = [np.zeros((0, 4, 4, 4))], [np.zeros(0, np.int32)]
+    return Scene(np.concatenate(all_patches), np.concatenate(all_ids), camera, name, meshes)
+
+
+def _physical_memory() -> int:
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):
+        return 16 * 2**30
+
+
+_MAX_SCENE_BYTES = _physical_memory() // 2  # a JSON scene may instance objects up to this
 
 
 class _JsonProblem(ValueError):
@@ -396,7 +441,7 @@ def _transform(value, where: _Where, key: str) -> np.ndarray:
     matrix = np.array(rows)
     linear = matrix[:3, :3]
     scale = np.abs(linear).max()
-    if scale == 0 or abs(np.linalg.det(linear)) <= 1e-12 * scale**3:
+    if scale == 0 or abs(np.linalg.det(linear / scale)) <= 1e-12:  # scaled: no overflow at 1e308
         raise where.error(key, "singular: the upper 3x3 has (nearly) zero determinant")
     return matrix
 
@@ -483,4 +528,5 @@ def write_bez(path, patches: np.ndarray) -> None:
     Path(path).write_text("\n".join(out) + "\n")
 
 
-_READERS = {".bpt": read_bpt, ".bez": read_bez, ".json": read_json_scene}
+_READERS = {".bpt": read_bpt, ".bez": read_bez, ".json": read_json_scene,
+            **{ext: read_mesh_scene for ext in MESH_EXTENSIONS}}

@@ -28,11 +28,16 @@ def patch_tolerances(patches: np.ndarray, eps: float | None = None, pixels: floa
     2 tan(fov_y/2) / height`` with ``depth`` the nearest depth of the patch's bounding box in
     front of the camera; boxes entirely outside one frustum plane are culled.
     """
-    count = len(patches)
+    points = (patches[..., :3] / patches[..., 3:]).reshape(len(patches), -1, 3)
+    return box_tolerances(points.min(axis=1), points.max(axis=1), eps, pixels, camera)
+
+
+def box_tolerances(lo: np.ndarray, hi: np.ndarray, eps: float | None = None, pixels: float | None = None,
+                   camera: Camera | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """patch_tolerances for patches given by their bounding boxes lo, hi (P, 3)."""
+    count = len(lo)
     if pixels is None:
         return np.full(count, float(eps)), np.zeros(count, bool)
-    points = patches[..., :3] / patches[..., 3:]
-    lo, hi = points.min(axis=(1, 2)), points.max(axis=(1, 2))
     corners = np.stack([np.where([(c >> a) & 1 for a in range(3)], hi, lo) for c in range(8)], axis=1)
     view = camera.view_matrix()
     cam = corners @ view[:3, :3].T + view[:3, 3]  # (P, 8, 3)
@@ -236,9 +241,11 @@ def quad_pattern(f: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray]:
 
 # --- stage 3: counts and offsets --------------------------------------------------------------
 
-def counts(factors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(vertex counts (P,), index counts (P,)) of each patch's pattern."""
-    patterns = [quad_pattern(f) for f in factors]
+def counts(factors: np.ndarray, kind: str = "bezier") -> tuple[np.ndarray, np.ndarray]:
+    """(vertex counts (P,), index counts (P,)) of each patch's pattern; kind "bezier" (quad_pattern)
+    or "pn" (tri_pattern)."""
+    pattern = {"bezier": quad_pattern, "pn": tri_pattern}[kind]
+    patterns = [pattern(f) for f in factors]
     return (np.array([len(uv) for uv, _ in patterns], np.int64),
             np.array([3 * len(t) for _, t in patterns], np.int64))
 
@@ -318,24 +325,28 @@ NORMAL_DEGENERATE = 1.0e-5  # |t_u x t_v| below this times |t_u|^2 + |t_v|^2 cou
 
 # --- stages 4 and 5: the whole tessellation --------------------------------------------------
 
-def tessellate(patches: np.ndarray, factors: np.ndarray, object_ids: np.ndarray | None = None) -> dict:
+def tessellate(patches: np.ndarray, factors: np.ndarray, object_ids: np.ndarray | None = None,
+               pattern=None, evaluator=None, patch_base: int = 0) -> dict:
     """Vertices and triangles of all patches at the given final factors (direct evaluation).
 
     Returns a dict of positions (V, 3), normals (V, 3), uv (V, 2), patch_ids (V,),
-    object_ids (V,), triangles (T, 3): the layout the kernels write.
+    object_ids (V,), triangles (T, 3): the layout the kernels write.  pattern, evaluator:
+    quad_pattern and evaluate by default (pn_tessellate passes the PN ones); patch ids are
+    ``patch_base + p``.
     """
+    pattern, evaluator = pattern or quad_pattern, evaluator or evaluate
     object_ids = np.zeros(len(patches), np.int32) if object_ids is None else object_ids
     out = {k: [] for k in ("positions", "normals", "uv", "patch_ids", "object_ids", "triangles")}
     first = 0
     for p, f in enumerate(factors):
-        uv, tris = quad_pattern(f)
+        uv, tris = pattern(f)
         if not len(uv):
             continue
-        pos, nrm = evaluate(patches[p], uv[:, 0], uv[:, 1])
+        pos, nrm = evaluator(patches[p], uv[:, 0], uv[:, 1])
         out["positions"].append(pos)
         out["normals"].append(nrm)
         out["uv"].append(uv)
-        out["patch_ids"].append(np.full(len(uv), p))
+        out["patch_ids"].append(np.full(len(uv), patch_base + p))
         out["object_ids"].append(np.full(len(uv), object_ids[p]))
         out["triangles"].append(tris + first)
         first += len(uv)
@@ -356,5 +367,253 @@ def boundary_point(curve: np.ndarray, k: int, f: int) -> np.ndarray:
     return c[:3] / c[3]
 
 
-__all__ = ["patch_tolerances", "zs_factors", "zs_steps", "crack_free_factors", "quad_pattern",
-           "counts", "offsets", "evaluate", "surface_points", "tessellate", "boundary_point", "boundary_curves"]
+# --- PN triangles (DESIGN.md section 3; CudaTess section 4) ------------------------------------
+#
+# Input per triangle (T, 12, 4), as uploaded by the pipeline: [0..2] positions P1 P2 P3, [3..5]
+# vertex normals N1 N2 N3, [6 + 2e], [7 + 2e] the normals edge e's boundary curve uses at its
+# start (corner e) and end (corner e+1).  Control points (T, 16, 4), the layout of
+# kernels/cltess.h: the ten b_ijk in CUBIC order (w = 1), the six n_ijk in QUADRATIC order (w = 0).
+# Domain: barycentric (u, v, w = 1-u-v) of P1, P2, P3; edge e runs from corner e to corner e+1.
+
+CUBIC = ((3, 0, 0), (0, 3, 0), (0, 0, 3), (2, 1, 0), (1, 2, 0), (0, 2, 1), (0, 1, 2), (1, 0, 2),
+         (2, 0, 1), (1, 1, 1))
+QUADRATIC = ((2, 0, 0), (0, 2, 0), (0, 0, 2), (1, 1, 0), (0, 1, 1), (1, 0, 1))
+_CUBIC_AT = {ijk: k for k, ijk in enumerate(CUBIC)}
+#: d_e, the domain direction of edge e in barycentric coordinates: corner e to corner e+1.
+EDGE_DIRECTIONS = np.array([[-1, 1, 0], [0, -1, 1], [1, 0, -1]])
+
+
+def pn_edge_control(p_near: np.ndarray, p_far: np.ndarray, n_near: np.ndarray) -> np.ndarray:
+    """(2 p_near + p_far - ((p_far - p_near) . n_near) n_near) / 3: a boundary curve's inner
+    control point next to p_near (n_near = 0: the straight edge's)."""
+    w = ((p_far - p_near) * n_near).sum(-1, keepdims=True)
+    return (2 * p_near + p_far - w * n_near) / 3
+
+
+def _unit_or_zero(a: np.ndarray) -> np.ndarray:
+    length = np.linalg.norm(a, axis=-1, keepdims=True)
+    return np.where(length > 0, a / np.where(length > 0, length, 1), 0.0)
+
+
+def pn_control_points(triangles: np.ndarray) -> np.ndarray:
+    """Control points and normal field (T, 16, 4) from the triangle input (T, 12, 4), Vlachos et al.
+
+    b300 = P1 ...; the inner control points of edge e from its end normals (input [6 + 2e],
+    [7 + 2e]); b111 = E + (E - V) / 2 with E the mean of the six, V of the corners; n200 = N1 ...,
+    n110 = normalize(N1 + N2 - v12 (P2 - P1)), v12 = 2 (P2 - P1).(N1 + N2) / |P2 - P1|^2 (0 when
+    P1 = P2).  Mirror of kernels/cltess.h pn_control_points.
+    """
+    triangles = np.asarray(triangles, float)
+    P, N, E = triangles[:, 0:3, :3], triangles[:, 3:6, :3], triangles[:, 6:12, :3]
+    out = np.zeros((len(triangles), 16, 4))
+    out[:, :10, 3] = 1.0
+    out[:, 0:3, :3] = P
+    for e in range(3):
+        p, q = P[:, e], P[:, (e + 1) % 3]
+        out[:, 3 + 2 * e, :3] = pn_edge_control(p, q, E[:, 2 * e])
+        out[:, 4 + 2 * e, :3] = pn_edge_control(q, p, E[:, 2 * e + 1])
+        d = q - p
+        length2 = (d * d).sum(-1, keepdims=True)
+        v = np.where(length2 > 0, 2 * (d * (N[:, e] + N[:, (e + 1) % 3])).sum(-1, keepdims=True)
+                     / np.where(length2 > 0, length2, 1), 0.0)
+        out[:, 13 + e, :3] = _unit_or_zero(N[:, e] + N[:, (e + 1) % 3] - v * d)
+    mean_edge = out[:, 3:9, :3].mean(axis=1)
+    centre = P.mean(axis=1)
+    out[:, 9, :3] = mean_edge + (mean_edge - centre) / 2
+    out[:, 10:13, :3] = N
+    return out
+
+
+def pn_second_derivative_bounds(controls: np.ndarray) -> np.ndarray:
+    """(T, 3, 3) bounds D[a, b] >= sup |D_{d_a} D_{d_b} b| over the triangle: 6 times the largest
+    norm of the three control points of (Delta_a Delta_b b), Delta_e b_I = b_{I+e_{e+1}} - b_{I+e_e}
+    (DESIGN.md section 3)."""
+    b = np.asarray(controls, float)[:, :10, :3]
+    bounds = np.zeros((len(b), 3, 3))
+    for a in range(3):
+        for c in range(3):
+            worst = np.zeros(len(b))
+            for base in range(3):
+                total = 0.0
+                for x, sx in (((a + 1) % 3, 1), (a, -1)):
+                    for y, sy in (((c + 1) % 3, 1), (c, -1)):
+                        ijk = [0, 0, 0]
+                        ijk[base] += 1
+                        ijk[x] += 1
+                        ijk[y] += 1
+                        total = total + sx * sy * b[:, _CUBIC_AT[tuple(ijk)]]
+                worst = np.maximum(worst, np.linalg.norm(total, axis=-1))
+            bounds[:, a, c] = 6 * worst
+    return bounds
+
+
+def pn_inverse_steps(controls: np.ndarray, eps: np.ndarray) -> np.ndarray:
+    """(T, 3) 1/delta_e from the Filip bound (CudaTess section 4):
+    (1/8) (D_ee + max(D_e,e+1, D_e,e+2)) delta_e^2 <= eps / 2."""
+    d = pn_second_derivative_bounds(controls)
+    eps = np.broadcast_to(np.asarray(eps, float), (len(d),))
+    out = np.zeros((len(d), 3))
+    for e in range(3):
+        curvature = d[:, e, e] + np.maximum(d[:, e, (e + 1) % 3], d[:, e, (e + 2) % 3])
+        out[:, e] = np.sqrt(curvature / (4 * eps))
+    return out
+
+
+def pn_tolerances(controls: np.ndarray, eps: float | None = None, pixels: float | None = None,
+                  camera: Camera | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """patch_tolerances for PN triangles: the box of the ten control points."""
+    points = np.asarray(controls, float)[:, :10, :3]
+    return box_tolerances(points.min(axis=1), points.max(axis=1), eps, pixels, camera)
+
+
+def pn_factors(controls: np.ndarray, eps: np.ndarray, culled: np.ndarray | None = None,
+               max_factor: int = DEFAULT_MAX_FACTOR) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Filip factors: (factors (T, 4) int32 = (f0, f1, f2, 0), unclamped (T, 3) = 1/delta_e,
+    saturated (T,) bool).  Culled and folded (pn_folded) triangles get factor 0 and are never
+    saturated."""
+    count = len(controls)
+    culled = np.zeros(count, bool) if culled is None else culled
+    culled = culled | pn_folded(controls)
+    unclamped = pn_inverse_steps(controls, eps)
+    unclamped[culled] = 0
+    finite = np.isfinite(unclamped)
+    clamped = np.where(finite & (unclamped <= max_factor), np.maximum(np.ceil(np.where(finite, unclamped, 1)), 1),
+                       max_factor)
+    factors = np.zeros((count, 4), np.int32)
+    factors[:, :3] = np.where(culled[:, None], 0, clamped)
+    saturated = ~culled & ~(unclamped <= max_factor).all(axis=1)
+    return factors, unclamped, saturated
+
+
+def pn_folded(controls: np.ndarray) -> np.ndarray:
+    """(T,) bool: two corners at exactly one point.  Such a triangle is a zero-area fold whose
+    other two edges coincide; pn_factors gives it factor 0 (no output) and its neighbours meet
+    directly (adjacency.mesh_edge_groups leaves its edges out)."""
+    p = np.asarray(controls)[:, :3, :3]
+    return np.any([(p[:, a] == p[:, (a + 1) % 3]).all(axis=1) for a in range(3)], axis=0)
+
+
+def tri_pattern(f) -> tuple[np.ndarray, np.ndarray]:
+    """The tessellation pattern of a triangle patch with edge factors f (CudaTess Fig. 5).
+
+    Core factor ``N = max(f0, f1, f2)``.  Vertex layout, boundary first: the ring of
+    ``R = f0+f1+f2`` points counter-clockwise from P1 (edge e, point k at ``t = k / f_e``), then
+    the factor-N grid's interior points ``(i / N, j / N)``, rows ``j = 1..N-2``, ``i = 1..N-1-j``
+    (u, v: the barycentric coordinates of P1, P2).
+
+    Triangles: the regular factor-N grid, less the band along each edge whose factor is below N
+    (a transition edge: at most two); each band is stitched Bresenham-style between the edge's
+    f_e segments and the grid row one step inside it, whose point m stands at (m + 1/2) / N
+    along the edge, advancing the side whose next segment midpoint comes first.  Where two
+    transition bands meet, each row stops at the crossing point of the two rows.  Every triangle
+    keeps the Filip bound: in coordinates along two edge directions scaled by their factors, its
+    smallest enclosing circle has radius^2 <= 1/2, as the core's grid triangles do (tests).
+
+    Returns (uv (V, 2) float64, triangles (T, 3) int64 local, counter-clockwise in uv).  Culled
+    (factor 0) triangles have none.  Factors (1, 1, 1) give the one triangle (0, 1, 2).
+    """
+    f = [int(x) for x in f[:3]]
+    if min(f) <= 0:
+        return np.zeros((0, 2)), np.zeros((0, 3), np.int64)
+    n = max(f)
+    ring_size = sum(f)
+    base = [0, f[0], f[0] + f[1]]
+    t = [int(fe < n) for fe in f]
+
+    def ring(e, k):
+        return (base[e] + k) % ring_size
+
+    def grid(i, j):
+        k = n - i - j
+        if i == n:
+            return 0
+        if j == n:
+            return base[1]
+        if k == n:
+            return base[2]
+        if k == 0:
+            return ring(0, j)
+        if i == 0:
+            return ring(1, k)
+        if j == 0:
+            return ring(2, i)
+        return ring_size + (j - 1) * (2 * n - 2 - j) // 2 + (i - 1)
+
+    def row(e, m):
+        c = [0, 0, 0]
+        c[e], c[(e + 1) % 3], c[(e + 2) % 3] = n - 1 - m, m, 1
+        return grid(c[0], c[1])
+
+    uv = []
+    for e in range(3):
+        for k in range(f[e]):
+            s, r = k / f[e], (f[e] - k) / f[e]
+            uv.append([(r, s), (0.0, r), (s, 0.0)][e])
+    uv += [(i / n, j / n) for j in range(1, n - 1) for i in range(1, n - j)]
+
+    tris = []
+    m = n - sum(t)
+    for j in range(m):
+        for i in range(m - j):
+            a, b = t[1] + i, t[2] + j
+            tris.append((grid(a + 1, b), grid(a, b + 1), grid(a, b)))
+            if i + j < m - 1:
+                tris.append((grid(a + 1, b), grid(a + 1, b + 1), grid(a, b + 1)))
+    for e in range(3):
+        if not t[e]:
+            continue
+        fe, o = f[e], 0
+        k, k_end = t[(e + 2) % 3], n - 1 - t[(e + 1) % 3]
+        while o < fe or k < k_end:
+            if k == k_end or (o < fe and (2 * o + 1) * n <= 2 * (k + 1) * fe):
+                tris.append((ring(e, o), ring(e, o + 1), row(e, k)))
+                o += 1
+            else:
+                tris.append((ring(e, o), row(e, k + 1), row(e, k)))
+                k += 1
+    return np.array(uv, float).reshape(-1, 2), np.array(tris, np.int64).reshape(-1, 3)
+
+
+def _pn_basis(u: np.ndarray, v: np.ndarray):
+    """(N, 10) cubic and (N, 6) quadratic Bernstein-triangle bases at (u, v, 1-u-v)."""
+    w = 1 - u - v
+    cubic = np.stack([math.factorial(3) / (math.factorial(i) * math.factorial(j) * math.factorial(k))
+                      * u ** i * v ** j * w ** k for i, j, k in CUBIC], axis=-1)
+    quadratic = np.stack([2 / (math.factorial(i) * math.factorial(j) * math.factorial(k))
+                          * u ** i * v ** j * w ** k for i, j, k in QUADRATIC], axis=-1)
+    return cubic, quadratic
+
+
+def pn_evaluate(controls: np.ndarray, u, v) -> tuple[np.ndarray, np.ndarray]:
+    """Positions and unit normals (N, 3) of one PN triangle (16, 4) at barycentric (u, v) (N,).
+
+    The normal is the normalised quadratic normal field; where it vanishes, the flat triangle's
+    normal (else +z)."""
+    u, v = np.atleast_1d(np.asarray(u, float)), np.atleast_1d(np.asarray(v, float))
+    controls = np.asarray(controls, float)
+    cubic, quadratic = _pn_basis(u, v)
+    position = cubic @ controls[:10, :3]
+    normal = quadratic @ controls[10:16, :3]
+    face = _unit_or_zero(np.cross(controls[1, :3] - controls[0, :3], controls[2, :3] - controls[0, :3]))
+    fallback = face if (face != 0).any() else np.array([0.0, 0.0, 1.0])
+    ok = (normal * normal).sum(1) > NORMAL_DEGENERATE ** 2
+    return position, np.where(ok[:, None], _unit_or_zero(normal), fallback)
+
+
+def pn_surface_points(controls: np.ndarray, patch_ids: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Positions (N, 3) of many PN triangles: sample n is triangle ``patch_ids[n]`` at (u[n], v[n])."""
+    cubic, _ = _pn_basis(np.asarray(u, float), np.asarray(v, float))
+    return np.einsum("nk,nkc->nc", cubic, np.asarray(controls, float)[patch_ids, :10, :3])
+
+
+def pn_tessellate(controls: np.ndarray, factors: np.ndarray, object_ids: np.ndarray | None = None,
+                  patch_base: int = 0) -> dict:
+    """tessellate for PN triangles: tri_pattern, pn_evaluate (ring points as boundary_point
+    places them, evaluated directly).  Patch ids are ``patch_base + t``."""
+    return tessellate(controls, factors, object_ids, tri_pattern, pn_evaluate, patch_base)
+
+
+__all__ = ["patch_tolerances", "box_tolerances", "zs_factors", "zs_steps", "crack_free_factors", "quad_pattern",
+           "counts", "offsets", "evaluate", "surface_points", "tessellate", "boundary_point", "boundary_curves",
+           "pn_control_points", "pn_edge_control", "pn_second_derivative_bounds", "pn_inverse_steps",
+           "pn_tolerances", "pn_factors", "pn_folded", "tri_pattern", "pn_evaluate", "pn_surface_points", "pn_tessellate"]

@@ -1,7 +1,15 @@
 """The scene data model: what every reader produces and every pipeline stage consumes.
 
-A scene is a batch of rational bicubic Bézier patches in homogeneous form plus an optional
-camera.  Patch layout (DESIGN.md section 2, issue 2): ``patches[p, j, i] = (w*x, w*y, w*z, w)``,
+A scene is a batch of rational bicubic Bézier patches in homogeneous form, any number of
+triangle meshes (tessellated as PN triangles, DESIGN.md section 3) and an optional camera.
+
+Patch numbering (``Tessellation.patch_ids``): the scene's Bézier patches first, in the order of
+``Scene.patches`` (0..P-1), then the triangles of ``Scene.meshes``, mesh after mesh, each in
+face order: face ``f`` of mesh ``m`` is patch ``Scene.mesh_first_patch(m) + f``.  For a scene of
+one mesh (a mesh file), the patch id is the face index.  Every vertex also carries its object
+id, so (object id, patch id - first patch of that object's mesh) names the face.
+
+Bézier patch layout (DESIGN.md section 2, issue 2): ``patches[p, j, i] = (w*x, w*y, w*z, w)``,
 ``i`` along u, ``j`` along v, both 0..3; the 16 points of a patch in file order are rows
 ``j = 0..3`` of four points ``i = 0..3``.
 
@@ -19,6 +27,7 @@ edge  curve     boundary control points, in order      factor of
 """
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -75,32 +84,213 @@ class Camera:
         return 2.0 * np.tan(np.radians(self.fov_y_deg) / 2.0) / self.height
 
 
+def vertex_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(V, 3) unit vertex normals as trimesh computes them (face normals weighted by the corner
+    angles), but summed over all vertices at the same float32 position, so that a mesh whose
+    vertices are split along UV seams still gets one normal per point.  Zero where a point
+    touches only degenerate triangles."""
+    vertices = np.asarray(vertices, np.float64)
+    faces = np.asarray(faces, np.int64)
+    welded = weld_positions(vertices)
+    corners = vertices[faces]  # (F, 3, 3)
+    normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    normal = _unit_rows(normal)
+    angles = np.zeros(faces.shape)
+    for c in range(3):
+        a = _unit_rows(corners[:, (c + 1) % 3] - corners[:, c])
+        b = _unit_rows(corners[:, (c + 2) % 3] - corners[:, c])
+        angles[:, c] = np.arccos(np.clip((a * b).sum(1), -1.0, 1.0))
+    total = np.zeros((welded.max() + 1, 3))
+    np.add.at(total, welded[faces].reshape(-1), (normal[:, None, :] * angles[..., None]).reshape(-1, 3))
+    return _unit_rows(total)[welded]
+
+
+def weld_positions(vertices: np.ndarray) -> np.ndarray:
+    """(V,) id per vertex, equal for vertices at bitwise the same float32 position (the device's
+    view of them; -0.0 = 0.0): the welding PN adjacency uses."""
+    keys = np.ascontiguousarray(np.asarray(vertices, np.float32) + np.float32(0.0))
+    _, welded = np.unique(keys.view(np.dtype((np.void, 12))).ravel(), return_inverse=True)
+    return welded.ravel()
+
+
+def _unit_rows(a: np.ndarray) -> np.ndarray:
+    length = np.linalg.norm(a, axis=1, keepdims=True)
+    return np.where(length > 0, a / np.where(length > 0, length, 1.0), 0.0)
+
+
+@dataclass
+class TriangleMesh:
+    """A triangle mesh with vertex normals, tessellated as PN triangles (DESIGN.md section 3).
+
+    Checked and repaired on construction; every problem raises :class:`SceneError` naming the
+    mesh and the vertex or face (0-based, as the file's loader numbered them):
+
+    vertices:  (V, 3) float64, finite.
+    faces:     (F, 3) int64 vertex indices in 0..V-1, at least one face.
+    normals:   (V, 3) float64 vertex normals.  Given (from the file): used as they are, only
+               scaled to unit length; those that are not finite or of zero length are replaced
+               by the computed normal (counted in ``repaired_normals``).  None: computed
+               (:func:`vertex_normals`: angle-weighted, over the welded positions).
+    object_id: the object id of every vertex of its tessellation.
+    name:      for messages.
+
+    ``degenerate_triangles`` counts faces of (near) zero area.  They are kept: a PN triangle
+    over a sliver is still a well-defined patch between its neighbours' curves, and dropping it
+    would open a hole.  The exception are *folded* ones, two corners at one point: their other
+    two edges are one edge, so the pipeline gives them no output and lets their neighbours meet
+    directly (``reference.pn_folded``; counted as ``folded_triangles`` in the stats).
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    normals: np.ndarray | None = None
+    object_id: int = 0
+    name: str = "<mesh>"
+    normals_from_file: bool = field(init=False, default=False)
+    repaired_normals: int = field(init=False, default=0)
+    degenerate_triangles: int = field(init=False, default=0)
+
+    def __post_init__(self) -> None:
+        name = self.name
+        vertices = np.asarray(self.vertices, dtype=np.float64)
+        if vertices.ndim != 2 or vertices.shape[1] != 3:
+            raise SceneError(f"{name}: vertices must have shape (V, 3), got {vertices.shape}")
+        bad = ~np.isfinite(vertices).all(axis=1)
+        if bad.any():
+            v = int(np.argmax(bad))
+            raise SceneError(f"{name}: vertex {v}: position {vertices[v].tolist()} is not finite")
+        faces = np.asarray(self.faces)
+        if faces.size == 0:
+            raise SceneError(f"{name}: the mesh has no faces (PN triangles need triangles)")
+        if faces.ndim != 2 or faces.shape[1] != 3:
+            raise SceneError(f"{name}: faces must be triangles, shape (F, 3), got {faces.shape}")
+        if not np.issubdtype(faces.dtype, np.integer):
+            if not (np.isfinite(faces).all() and (faces == np.round(faces)).all()):
+                raise SceneError(f"{name}: face vertex indices must be integers")
+        faces = faces.astype(np.int64)
+        out = (faces < 0) | (faces >= len(vertices))
+        if out.any():
+            f, c = (int(x) for x in np.argwhere(out)[0])
+            raise SceneError(f"{name}: face {f}: vertex index {int(faces[f, c])} out of range "
+                             f"0..{len(vertices) - 1}")
+        self.vertices, self.faces = vertices, faces
+        if self.object_id is None or not 0 <= int(self.object_id) <= 2**31 - 1:
+            raise SceneError(f"{name}: object id {self.object_id!r} is not in 0..2**31-1")
+        self.object_id = int(self.object_id)
+
+        corners = vertices[faces]
+        area2 = np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
+        longest2 = np.max([((corners[:, (c + 1) % 3] - corners[:, c]) ** 2).sum(1) for c in range(3)], axis=0)
+        self.degenerate_triangles = int((area2 <= 1e-12 * longest2).sum())
+
+        computed = None
+        self.normals_from_file = self.normals is not None
+        if self.normals is None:
+            normals = computed = vertex_normals(vertices, faces)
+        else:
+            normals = np.array(self.normals, dtype=np.float64)
+            if normals.shape != vertices.shape:
+                raise SceneError(f"{name}: normals must have shape {vertices.shape} (one per vertex), "
+                                 f"got {normals.shape}")
+            length = np.linalg.norm(np.where(np.isfinite(normals), normals, 0.0), axis=1)
+            bad = ~np.isfinite(normals).all(axis=1) | ~(length > 0)
+            normals[~bad] /= length[~bad, None]
+            if bad.any():
+                computed = vertex_normals(vertices, faces)
+                normals[bad] = computed[bad]
+            self.repaired_normals = int(bad.sum())
+        self.normals = normals
+
+    @property
+    def num_faces(self) -> int:
+        return len(self.faces)
+
+    def transformed(self, matrix: np.ndarray, object_id: int | None = None) -> "TriangleMesh":
+        """A copy moved by an affine row-major 4x4 ``matrix`` (last row 0 0 0 1; ValueError else):
+        positions ``M p``, normals by the inverse transpose of its 3x3, unit length again."""
+        matrix = np.asarray(matrix, np.float64)
+        if not np.array_equal(matrix[3], [0.0, 0.0, 0.0, 1.0]):
+            raise ValueError("a mesh takes only affine transforms (last row 0 0 0 1)")
+        out = copy.copy(self)
+        with np.errstate(over="ignore", invalid="ignore"):
+            out.vertices = self.vertices @ matrix[:3, :3].T + matrix[:3, 3]
+            out.normals = _unit_rows(self.normals @ np.linalg.inv(matrix[:3, :3]))
+        bad = ~np.isfinite(out.vertices).all(axis=1)
+        if bad.any():
+            raise ValueError(f"vertex {int(np.argmax(bad))}: not finite after the transform")
+        if object_id is not None:
+            out.object_id = int(object_id)
+        return out
+
+    @staticmethod
+    def from_trimesh(mesh, object_id: int = 0, name: str | None = None) -> "TriangleMesh":
+        """From a ``trimesh.Trimesh``: its vertex normals only where it holds some already (read
+        from the file, or given to its constructor), never ones trimesh would compute on access."""
+        cache = getattr(mesh, "_cache", None)
+        normals = np.asarray(mesh.vertex_normals) if cache is not None and "vertex_normals" in cache else None
+        return TriangleMesh(np.asarray(mesh.vertices), np.asarray(mesh.faces), normals, object_id,
+                            name or str(getattr(mesh, "metadata", {}).get("file_name", "<trimesh>")))
+
+
 @dataclass
 class Scene:
-    """Rational bicubic Bézier patches ready for the pipeline.
+    """Rational bicubic Bézier patches and triangle meshes ready for the pipeline.
 
     patches:    (P, 4, 4, 4) float64, homogeneous ``(w*x, w*y, w*z, w)``, ``[p, j, i]``.
     object_ids: (P,) int32, the object each patch came from.
     camera:     optional camera for ``pixels`` tolerances.
     name:       where the scene came from (for messages).
+    meshes:     triangle meshes (PN triangles), each with its own object id.
+
+    Patches are numbered Bézier first, then mesh faces (module docstring).
     """
 
     patches: np.ndarray
     object_ids: np.ndarray
     camera: Camera | None = None
     name: str = "<scene>"
+    meshes: list = field(default_factory=list)
 
     def __post_init__(self) -> None:
         self.patches = np.ascontiguousarray(self.patches, dtype=np.float64)
         self.object_ids = np.ascontiguousarray(self.object_ids, dtype=np.int32)
+        if self.patches.size == 0 and self.patches.shape[1:] != (4, 4, 4):
+            self.patches = self.patches.reshape(0, 4, 4, 4)
         if self.patches.ndim != 4 or self.patches.shape[1:] != (4, 4, 4):
             raise SceneError(f"{self.name}: patches must have shape (P, 4, 4, 4), got {self.patches.shape}")
         if self.object_ids.shape != (len(self.patches),):
             raise SceneError(f"{self.name}: need one object id per patch")
+        self.meshes = list(self.meshes)
+        if not all(isinstance(mesh, TriangleMesh) for mesh in self.meshes):
+            raise SceneError(f"{self.name}: meshes must be TriangleMesh objects")
 
     @property
     def num_patches(self) -> int:
+        """All patches: Bézier patches and mesh triangles."""
+        return len(self.patches) + self.num_triangles
+
+    @property
+    def num_bezier(self) -> int:
         return len(self.patches)
+
+    @property
+    def num_triangles(self) -> int:
+        """Triangles over all meshes (the PN patches)."""
+        return sum(mesh.num_faces for mesh in self.meshes)
+
+    def mesh_first_patch(self, m: int) -> int:
+        """Patch id of face 0 of mesh m."""
+        return len(self.patches) + sum(mesh.num_faces for mesh in self.meshes[:m])
+
+    @staticmethod
+    def from_meshes(meshes, camera: Camera | None = None, name: str = "<scene>") -> "Scene":
+        """A scene of triangle meshes only."""
+        return Scene(np.zeros((0, 4, 4, 4)), np.zeros(0, np.int32), camera, name, list(meshes))
+
+    @staticmethod
+    def from_trimesh(mesh, camera: Camera | None = None, name: str = "<trimesh>", object_id: int = 0) -> "Scene":
+        """A scene of one ``trimesh.Trimesh`` (see TriangleMesh.from_trimesh for its normals)."""
+        return Scene.from_meshes([TriangleMesh.from_trimesh(mesh, object_id, name)], camera, name)
 
     @property
     def weights(self) -> np.ndarray:

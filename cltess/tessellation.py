@@ -12,11 +12,14 @@ class Tessellation:
 
     positions:  (V, 3) float32
     normals:    (V, 3) float32, unit length
-    uv:         (V, 2) float32, the patch parameters of each vertex
-    patch_ids:  (V,) int32, the patch each vertex belongs to
+    uv:         (V, 2) float32, the patch parameters of each vertex (PN triangles: the
+                barycentric weights of the face's first two corners)
+    patch_ids:  (V,) int32, the patch each vertex belongs to: the scene's Bézier patches
+                first, then its meshes' faces (``cltess.scene``; a mesh file: the face index)
     object_ids: (V,) int32, the object of that patch
     triangles:  (T, 3) uint32, counter-clockwise seen from the normal side
-    factors:    (P, 4) int32, the final (crack-free) edge factors; 0 = culled
+    factors:    (P, 4) int32, the final (crack-free) edge factors; 0 = culled (PN triangles:
+                (f0, f1, f2, 0))
     stage_ms:   device milliseconds per stage, from OpenCL profiling events
     stats:      counts for the summary: patches, culled, saturated, shared/boundary edges...
     """

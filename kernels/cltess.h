@@ -1,9 +1,15 @@
 /* Shared device math of the cltess pipeline: Bernstein bases, rational patch evaluation,
- * Zheng-Sederberg steps and the quad tessellation pattern.  Every stage includes this file;
+ * Zheng-Sederberg steps and the quad tessellation pattern; PN triangles (control points,
+ * evaluation, Filip bounds) and the triangle pattern.  Every stage includes this file;
  * cltess/reference.py is the NumPy mirror of each routine (same names).
  *
- * Patch layout: 16 float4 homogeneous control points b[4*j + i] = (w*x, w*y, w*z, w),
+ * Quad patch layout: 16 float4 homogeneous control points b[4*j + i] = (w*x, w*y, w*z, w),
  * i along u, j along v.  Edges counter-clockwise: 0: v=0, 1: u=1, 2: v=1, 3: u=0.
+ *
+ * PN triangle layout (the stage-1 output, also 16 float4; reference.pn_control_points):
+ * b[0..9] = b300 b030 b003 b210 b120 b021 b012 b102 b201 b111 (w = 1), b[10..15] = n200 n020
+ * n002 n110 n011 n101 (w = 0).  Domain: barycentric (u, v, w = 1-u-v) weighting corners P1, P2,
+ * P3; edge e runs from corner e to corner e+1 (0: P1->P2, w=0; 1: P2->P3, u=0; 2: P3->P1, v=0).
  */
 #ifndef CLTESS_H
 #define CLTESS_H
@@ -275,6 +281,261 @@ inline uint quad_triangles(int4 f, __global uint *out, uint base)
             } else {
                 put_triangle(out, &count, base, ring_index(f, e, o), inner_edge_index(f, core, e, k + 1),
                              inner_edge_index(f, core, e, k));
+                ++k;
+            }
+        }
+    }
+    return count;
+}
+
+/* --- PN triangles (DESIGN.md section 3, reference.pn_*) --------------------------------------- */
+
+/* Index of the cubic control point b_ijk (k = 3-i-j) and of the quadratic normal control n_ijk
+ * (k = 2-i-j) in the 16-float4 PN layout above. */
+__constant int PN_CUBIC[16] = {2, 6, 5, 1, 7, 9, 4, -1, 8, 3, -1, -1, 0, -1, -1, -1};
+__constant int PN_QUADRATIC[9] = {12, 14, 11, 15, 13, -1, 10, -1, -1};
+
+inline float dot3(float3 a, float3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+
+inline float3 unit_or_zero(float3 a)
+{
+    float len = sqrt(dot3(a, a));
+    return len > 0.0f ? a / len : (float3)(0.0f);
+}
+
+/* The inner control point of a boundary curve next to its end p_near (Vlachos et al.):
+ * (2 p_near + p_far - ((p_far - p_near) . n_near) n_near) / 3.  One expression with the dot
+ * product written out, so that the two triangles sharing an edge, which meet it from opposite
+ * ends, compute bitwise the same point.  n_near = 0 gives the straight edge's third point. */
+inline float3 pn_edge_control(float3 p_near, float3 p_far, float3 n_near)
+{
+    float w = dot3(p_far - p_near, n_near);
+    return (2.0f * p_near + p_far - w * n_near) / 3.0f;
+}
+
+/* n_ij of the quadratic normal field: normalize(N_i + N_j - v_ij (P_j - P_i)),
+ * v_ij = 2 (P_j - P_i).(N_i + N_j) / |P_j - P_i|^2 (0 on a zero-length edge). */
+inline float3 pn_mid_normal(float3 p_i, float3 p_j, float3 n_i, float3 n_j)
+{
+    float3 d = p_j - p_i;
+    float len2 = dot3(d, d);
+    float v = len2 > 0.0f ? 2.0f * dot3(d, n_i + n_j) / len2 : 0.0f;
+    return unit_or_zero(n_i + n_j - v * d);
+}
+
+/* Stage 1's PN control points from one triangle's input (12 float4, Tessellator's PN upload):
+ * in[0..2] positions P1 P2 P3, in[3..5] vertex normals N1 N2 N3 (the normal field), in[6..11]
+ * the normals each boundary curve uses at its two ends, edge e at in[6 + 2e] (start, corner e)
+ * and in[7 + 2e] (end, corner e+1): the vertex normals, or 0 for a straight edge, or the
+ * average over the triangles at a sharp edge (cltess/adjacency.py, pn_edge_normals). */
+inline void pn_control_points(const float4 in[12], float4 b[16])
+{
+    for (int c = 0; c < 3; ++c)
+        b[c] = (float4)(in[c].xyz, 1.0f);
+    float3 sum = (float3)(0.0f);
+    __attribute__((opencl_unroll_hint))
+    for (int e = 0; e < 3; ++e) {
+        float3 p = in[e].xyz, q = in[(e + 1) % 3].xyz;
+        float3 near = pn_edge_control(p, q, in[6 + 2 * e].xyz);
+        float3 far = pn_edge_control(q, p, in[7 + 2 * e].xyz);
+        b[3 + 2 * e] = (float4)(near, 1.0f);
+        b[4 + 2 * e] = (float4)(far, 1.0f);
+        sum += near + far;
+    }
+    float3 mean_edge = sum / 6.0f;
+    float3 centre = (in[0].xyz + in[1].xyz + in[2].xyz) / 3.0f;
+    b[9] = (float4)(mean_edge + (mean_edge - centre) / 2.0f, 1.0f);
+    __attribute__((opencl_unroll_hint))
+    for (int c = 0; c < 3; ++c) {
+        b[10 + c] = (float4)(in[3 + c].xyz, 0.0f);
+        b[13 + c] = (float4)(pn_mid_normal(in[c].xyz, in[(c + 1) % 3].xyz, in[3 + c].xyz,
+                                           in[3 + (c + 1) % 3].xyz), 0.0f);
+    }
+}
+
+/* The 4 control points of edge e's boundary curve, from corner e to corner e+1. */
+inline void pn_edge_curve(const float4 b[16], int e, float4 c[4])
+{
+    c[0] = b[e];
+    c[1] = b[3 + 2 * e];
+    c[2] = b[4 + 2 * e];
+    c[3] = b[(e + 1) % 3];
+}
+
+/* Bounds of the second directional derivatives |D_{d_a} D_{d_b} b| over the triangle, d_e the
+ * domain direction of edge e (corner e to corner e+1): D_{da,db} b = 6 sum_{|I|=1}
+ * (Delta_a Delta_b b)_I B1_I with Delta_e b_I = b_{I+e_{e+1}} - b_{I+e_e}, bounded by the
+ * largest of its three control points (DESIGN.md section 3).  Returns d[3 * a + b]. */
+inline void pn_second_derivative_bounds(const float4 b[16], float d[9])
+{
+    __attribute__((opencl_unroll_hint))
+    for (int a = 0; a < 3; ++a)
+        __attribute__((opencl_unroll_hint))
+        for (int c = a; c < 3; ++c) {
+            float worst = 0.0f;
+            __attribute__((opencl_unroll_hint))
+            for (int base = 0; base < 3; ++base) {
+                float3 sum = (float3)(0.0f);
+                __attribute__((opencl_unroll_hint))
+                for (int s = 0; s < 4; ++s) {  /* (+e_{a+1} or +e_a) + (+e_{c+1} or +e_c) */
+                    int x = (s & 1) ? a : (a + 1) % 3, y = (s & 2) ? c : (c + 1) % 3;
+                    int idx[3] = {0, 0, 0};
+                    idx[base] += 1;
+                    idx[x] += 1;
+                    idx[y] += 1;
+                    float sign = ((s & 1) ^ ((s >> 1) & 1)) ? -1.0f : 1.0f;
+                    sum += sign * b[PN_CUBIC[4 * idx[0] + idx[1]]].xyz;
+                }
+                worst = max(worst, length(sum));
+            }
+            d[3 * a + c] = d[3 * c + a] = 6.0f * worst;
+        }
+}
+
+/* Cubic and quadratic Bernstein-triangle sums at barycentric (u, v, w). */
+inline float3 pn_position(const float4 b[16], float3 t)
+{
+    float u = t.x, v = t.y, w = t.z;
+    return u * u * u * b[0].xyz + v * v * v * b[1].xyz + w * w * w * b[2].xyz
+         + 3.0f * (u * u * v * b[3].xyz + u * v * v * b[4].xyz + v * v * w * b[5].xyz
+                   + v * w * w * b[6].xyz + u * w * w * b[7].xyz + u * u * w * b[8].xyz)
+         + 6.0f * u * v * w * b[9].xyz;
+}
+
+inline float3 pn_normal_field(const float4 b[16], float3 t)
+{
+    float u = t.x, v = t.y, w = t.z;
+    return u * u * b[10].xyz + v * v * b[11].xyz + w * w * b[12].xyz
+         + 2.0f * (u * v * b[13].xyz + v * w * b[14].xyz + u * w * b[15].xyz);
+}
+
+/* The unit normal from the normal field; where it vanishes, the flat triangle's normal. */
+inline float3 pn_unit_normal(const float4 b[16], float3 n)
+{
+    if (dot3(n, n) > NORMAL_DEGENERATE * NORMAL_DEGENERATE)
+        return unit_or_zero(n);
+    float3 face = unit_or_zero(cross(b[1].xyz - b[0].xyz, b[2].xyz - b[0].xyz));
+    return dot3(face, face) > 0.0f ? face : (float3)(0.0f, 0.0f, 1.0f);
+}
+
+/* Blossoms (polar forms) of the cubic and of the normal field at barycentric points: the
+ * Bezier controls of the patch restricted to the segment from x to y are B(x,x,x), B(x,x,y),
+ * B(x,y,y), B(y,y,y) (forward differencing along rows, DESIGN.md section 6). */
+inline float4 pn_blossom3(const float4 b[16], float3 x, float3 y, float3 z)
+{
+    float4 q[6];  /* quadratic level, |I| = 2, in PN_QUADRATIC order minus 10 */
+    for (int i = 0; i <= 2; ++i)
+        for (int j = 0; i + j <= 2; ++j)
+            q[PN_QUADRATIC[3 * i + j] - 10] = x.x * b[PN_CUBIC[4 * (i + 1) + j]]
+                + x.y * b[PN_CUBIC[4 * i + j + 1]] + x.z * b[PN_CUBIC[4 * i + j]];
+    float4 l[3];  /* linear level: (1,0,0), (0,1,0), (0,0,1) */
+    l[0] = y.x * q[0] + y.y * q[3] + y.z * q[5];
+    l[1] = y.x * q[3] + y.y * q[1] + y.z * q[4];
+    l[2] = y.x * q[5] + y.y * q[4] + y.z * q[2];
+    return z.x * l[0] + z.y * l[1] + z.z * l[2];
+}
+
+inline float4 pn_blossom2(const float4 b[16], float3 x, float3 y)
+{
+    float4 l[3];
+    l[0] = x.x * b[10] + x.y * b[13] + x.z * b[15];
+    l[1] = x.x * b[13] + x.y * b[11] + x.z * b[14];
+    l[2] = x.x * b[15] + x.y * b[14] + x.z * b[12];
+    return y.x * l[0] + y.y * l[1] + y.z * l[2];
+}
+
+/* --- the triangle pattern (DESIGN.md section 5, reference.tri_pattern) ------------------------ */
+
+/* Core factor N = the largest edge factor (CudaTess section 4).  Vertex layout, boundary
+ * first: the ring of f0 + f1 + f2 points counter-clockwise from P1 (edge e, point k at
+ * t = k / f_e), then the interior grid points (i/N, j/N), i, j, k >= 1, in rows j = 1..N-2,
+ * i = 1..N-1-j.  All of the factor-N grid's interior points are vertices whatever the edges. */
+inline int tri_core(int4 f) { return max(max(f.s0, f.s1), f.s2); }
+
+inline uint tri_vertex_count(int4 f)
+{
+    if (f.s0 <= 0)
+        return 0;
+    int n = tri_core(f);
+    return (uint)(f.s0 + f.s1 + f.s2 + (n - 1) * (n - 2) / 2);
+}
+
+inline uint tri_ring_index(int4 f, int e, int k)
+{
+    int ring = f.s0 + f.s1 + f.s2;
+    int base = e == 0 ? 0 : e == 1 ? f.s0 : f.s0 + f.s1;
+    return (uint)((base + k) % ring);
+}
+
+inline uint tri_interior_index(int4 f, int n, int i, int j)
+{
+    return (uint)(f.s0 + f.s1 + f.s2 + (j - 1) * (2 * n - 2 - j) / 2 + (i - 1));
+}
+
+/* Grid point (i, j, n-i-j) of the factor-n grid: a corner, a point of an edge whose factor is
+ * n (the pattern uses no other boundary grid points), or an interior point. */
+inline uint tri_grid_index(int4 f, int n, int i, int j)
+{
+    int k = n - i - j;
+    if (i == n) return 0;
+    if (j == n) return (uint)f.s0;
+    if (k == n) return (uint)(f.s0 + f.s1);
+    if (k == 0) return tri_ring_index(f, 0, j);
+    if (i == 0) return tri_ring_index(f, 1, k);
+    if (j == 0) return tri_ring_index(f, 2, i);
+    return tri_interior_index(f, n, i, j);
+}
+
+/* Point m (0..n-1, along the edge's direction) of the grid row one step inside edge e. */
+inline uint tri_row_index(int4 f, int n, int e, int m)
+{
+    int c[3];
+    c[e] = n - 1 - m;
+    c[(e + 1) % 3] = m;
+    c[(e + 2) % 3] = 1;
+    return tri_grid_index(f, n, c[0], c[1]);
+}
+
+/* The triangle pattern's triangles, in "count" mode (out == 0) or "emit" mode (out != 0), like
+ * quad_triangles.  The uniform core is the regular factor-N grid less the band along each edge
+ * whose factor is below N (a transition edge; at most two, since one edge has N).  Each
+ * transition band is stitched between the edge's f_e segments and the grid row inside it,
+ * advancing the side whose next segment midpoint comes first, with the row's points placed at
+ * (m + 1/2) / N (midway between their two projections onto the edge):
+ * (o + 1/2) / f_e <= (m + 1) / N, in integers.  With two transition edges, each row stops
+ * where the two rows cross (the paper's modification: the row runs on the extended core grid,
+ * less its first, virtual segment).  Factors (1, 1, 1) give the triangle (P1, P2, P3). */
+inline uint tri_triangles(int4 f, __global uint *out, uint base)
+{
+    uint count = 0;
+    if (f.s0 <= 0)
+        return 0;
+    int n = tri_core(f);
+    int t[3] = {f.s0 < n, f.s1 < n, f.s2 < n};
+    /* The core: the regular grid of factor m on the points whose coordinate (e+2)%3, which is 0
+     * on edge e, is at least t[e]; up and down triangles, counter-clockwise. */
+    int m = n - t[0] - t[1] - t[2];
+    for (int j = 0; j < m; ++j)
+        for (int i = 0; i + j < m; ++i) {
+            int a = t[1] + i, b = t[2] + j;  /* grid point (a, b, n-a-b) */
+            put_triangle(out, &count, base, tri_grid_index(f, n, a + 1, b),
+                         tri_grid_index(f, n, a, b + 1), tri_grid_index(f, n, a, b));
+            if (i + j < m - 1)
+                put_triangle(out, &count, base, tri_grid_index(f, n, a + 1, b),
+                             tri_grid_index(f, n, a + 1, b + 1), tri_grid_index(f, n, a, b + 1));
+        }
+    for (int e = 0; e < 3; ++e) {
+        if (!t[e])
+            continue;
+        int fe = factor_of(f, e), o = 0, k = t[(e + 2) % 3], k_end = n - 1 - t[(e + 1) % 3];
+        while (o < fe || k < k_end) {
+            if (k == k_end || (o < fe && (2 * o + 1) * n <= 2 * (k + 1) * fe)) {
+                put_triangle(out, &count, base, tri_ring_index(f, e, o), tri_ring_index(f, e, o + 1),
+                             tri_row_index(f, n, e, k));
+                ++o;
+            } else {
+                put_triangle(out, &count, base, tri_ring_index(f, e, o), tri_row_index(f, n, e, k + 1),
+                             tri_row_index(f, n, e, k));
                 ++k;
             }
         }

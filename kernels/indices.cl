@@ -1,9 +1,10 @@
-/* Stage 5: triangle indices, the pattern routine in "emit" mode.  Mirror: reference.quad_pattern.
- * One work-item per patch. */
+/* Stage 5: triangle indices, the pattern routine in "emit" mode.  Mirror: reference.quad_pattern
+ * and reference.tri_pattern.  One work-item per patch. */
 #include "cltess.h"
 
-/* Patches first_patch .. first_patch + num_patches - 1 (one batch); their indices go to
- * index_offsets[p] - index_base and number the vertices globally (vertex_offsets[p]). */
+/* Patches first_patch .. first_patch + num_patches - 1 (one batch, scene numbering); their
+ * indices go to index_offsets[p] - index_base and number the vertices globally
+ * (vertex_offsets[p]). */
 __kernel void quad_indices(__global const int4 *factors, __global const ulong *vertex_offsets,
                            __global const ulong *index_offsets, uint first_patch, uint num_patches,
                            ulong index_base, __global uint *indices)
@@ -12,4 +13,14 @@ __kernel void quad_indices(__global const int4 *factors, __global const ulong *v
         return;
     uint p = first_patch + (uint)get_global_id(0);
     quad_triangles(factors[p], indices + (index_offsets[p] - index_base), (uint)vertex_offsets[p]);
+}
+
+__kernel void pn_indices(__global const int4 *factors, __global const ulong *vertex_offsets,
+                         __global const ulong *index_offsets, uint first_patch, uint num_patches,
+                         ulong index_base, __global uint *indices)
+{
+    if (get_global_id(0) >= num_patches)
+        return;
+    uint p = first_patch + (uint)get_global_id(0);
+    tri_triangles(factors[p], indices + (index_offsets[p] - index_base), (uint)vertex_offsets[p]);
 }

@@ -1,7 +1,8 @@
-/* Stage 4: vertex data of each patch in the pattern's layout (reference.quad_pattern): the
- * boundary ring first, evaluated canonically from the edge curves so that neighbours agree
- * bitwise, then the inner grid row by row, by forward differencing or direct evaluation.
- * Mirror: reference.tessellate.  One work-item per patch. */
+/* Stage 4: vertex data of each patch in the pattern's layout (reference.quad_pattern,
+ * reference.tri_pattern): the boundary ring first, evaluated canonically from the edge curves so
+ * that neighbours agree bitwise, then the inner grid row by row, by forward differencing or
+ * direct evaluation.  Mirror: reference.tessellate, reference.pn_tessellate.
+ * One work-item per patch. */
 #include "cltess.h"
 
 typedef struct {
@@ -49,11 +50,12 @@ inline void step_differences(float4 d[4])
     d[2] += d[3];
 }
 
-/* Patches first_patch .. first_patch + num_patches - 1 (one batch); their vertices go to
- * vertex_offsets[p] - vertex_base of the output arrays. */
+/* Patches first_patch .. first_patch + num_patches - 1 (one batch, scene numbering: the kind's
+ * own patch p - patch_base); their vertices go to vertex_offsets[p] - vertex_base of the output
+ * arrays. */
 __kernel void quad_vertices(__global const float4 *patches, __global const int4 *factors,
                             __global const ulong *vertex_offsets, __global const int *patch_objects,
-                            uint first_patch, uint num_patches, ulong vertex_base,
+                            uint first_patch, uint num_patches, uint patch_base, ulong vertex_base,
                             int forward_differencing,
                             __global float *positions, __global float *normals, __global float *uvs,
                             __global int *patch_ids, __global int *object_ids)
@@ -67,7 +69,7 @@ __kernel void quad_vertices(__global const float4 *patches, __global const int4 
     vertex_out out = {positions, normals, uvs, patch_ids, object_ids};
     int object = patch_objects[p];
     float4 b[16];
-    load_patch(patches, p, b);
+    load_patch(patches, p - patch_base, b);
     ulong at = vertex_offsets[p] - vertex_base;
 
     /* The boundary ring, counter-clockwise from (0, 0). */
@@ -114,6 +116,84 @@ __kernel void quad_vertices(__global const float4 *patches, __global const int4 
             }
             put_vertex(out, at++, value.xyz / value.w, surface_normal(b, u, v, value, du, dv),
                        (float2)(u, v), p, object);
+        }
+    }
+}
+
+/* Barycentric (u, v, w) of point k of f on triangle edge e (corner e to corner e+1). */
+inline float3 tri_edge_point(int e, int k, int f)
+{
+    float t = (float)k / (float)f, s = (float)(f - k) / (float)f;
+    return e == 0 ? (float3)(s, t, 0.0f) : e == 1 ? (float3)(0.0f, s, t) : (float3)(t, 0.0f, s);
+}
+
+/* PN triangles, same arguments as quad_vertices with controls = stage 1's PN control points.
+ * (u, v) of a vertex are its barycentric coordinates of P1 and P2. */
+__kernel void pn_vertices(__global const float4 *controls, __global const int4 *factors,
+                          __global const ulong *vertex_offsets, __global const int *patch_objects,
+                          uint first_patch, uint num_patches, uint patch_base, ulong vertex_base,
+                          int forward_differencing,
+                          __global float *positions, __global float *normals, __global float *uvs,
+                          __global int *patch_ids, __global int *object_ids)
+{
+    if (get_global_id(0) >= num_patches)
+        return;
+    uint p = first_patch + (uint)get_global_id(0);
+    int4 f = factors[p];
+    if (f.s0 <= 0)
+        return;
+    vertex_out out = {positions, normals, uvs, patch_ids, object_ids};
+    int object = patch_objects[p];
+    float4 b[16];
+    load_patch(controls, p - patch_base, b);
+    ulong at = vertex_offsets[p] - vertex_base;
+
+    /* The boundary ring, counter-clockwise from P1: each edge's own curve, points placed
+     * symmetrically (boundary_point), so the neighbour's are bitwise the same; corners exact. */
+    for (int e = 0; e < 3; ++e) {
+        float4 c[4];
+        pn_edge_curve(b, e, c);
+        int fe = factor_of(f, e);
+        for (int k = 0; k < fe; ++k) {
+            float3 t = tri_edge_point(e, k, fe);
+            put_vertex(out, at++, boundary_point(c, k, fe).xyz, pn_unit_normal(b, pn_normal_field(b, t)),
+                       t.xy, p, object);
+        }
+    }
+
+    /* The interior grid (i / n, j / n), rows j = 1..n-2 of constant v.  Row j runs from
+     * x = (0, v, 1-v) to y = (1-v, v, 0); on it the patch is the cubic Bezier curve with controls
+     * B(x,x,x) .. B(y,y,y) (blossoms) in s = u / (1-v), the normal field a quadratic, and the
+     * points i = 1..n-1-j sit at s = i / (n - j). */
+    int n = tri_core(f);
+    for (int j = 1; j < n - 1; ++j) {
+        float v = (float)j / (float)n, rest = (float)(n - j) / (float)n;
+        float3 x = (float3)(0.0f, v, rest), y = (float3)(rest, v, 0.0f);
+        float4 c[4], a[4], s[4], nd[4];
+        float h = 1.0f / (float)(n - j);
+        if (forward_differencing) {
+            c[0] = pn_blossom3(b, x, x, x);
+            c[1] = pn_blossom3(b, x, x, y);
+            c[2] = pn_blossom3(b, x, y, y);
+            c[3] = pn_blossom3(b, y, y, y);
+            power_form(c, a);
+            cubic_differences(a[0], a[1], a[2], a[3], h, s);
+            float4 q0 = pn_blossom2(b, x, x), q1 = pn_blossom2(b, x, y), q2 = pn_blossom2(b, y, y);
+            cubic_differences(q0, 2.0f * (q1 - q0), q0 - 2.0f * q1 + q2, (float4)(0.0f), h, nd);
+        }
+        for (int i = 1; i < n - j; ++i) {
+            float3 t = (float3)((float)i / (float)n, v, (float)(n - i - j) / (float)n);
+            float3 position, normal;
+            if (forward_differencing) {
+                step_differences(s);
+                step_differences(nd);
+                position = s[0].xyz;
+                normal = nd[0].xyz;
+            } else {
+                position = pn_position(b, t);
+                normal = pn_normal_field(b, t);
+            }
+            put_vertex(out, at++, position, pn_unit_normal(b, normal), t.xy, p, object);
         }
     }
 }

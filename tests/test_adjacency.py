@@ -278,3 +278,28 @@ def test_100k_patches_fast():
     elapsed = time.perf_counter() - start
     assert groups.shared == 2 * (side - 1) * side
     assert elapsed < 5.0, f"edge_groups on {len(patches)} patches took {elapsed:.2f} s"
+
+
+def test_merged_groups_of_two_kinds_keep_each_kinds_groups(rng):
+    """Bézier patch-edges (4 per patch) then triangle edges (3 per triangle, the fourth slot
+    unused) in one (P, 4) layout: the same groups, unused slots alone, counts summed."""
+    import trimesh
+
+    from cltess.adjacency import merge_edge_groups, mesh_edge_groups
+    from support import closed_torus_grid
+
+    bezier = edge_groups(closed_torus_grid(rng, 4, 3).patches)
+    sphere = trimesh.creation.icosphere(subdivisions=1)
+    corners = np.asarray(sphere.vertices, np.float32)[sphere.faces]
+    mesh, _ = mesh_edge_groups(corners)
+    merged = merge_edge_groups([(bezier, 4, 0), (mesh, 3, 12)], 12 + 80)
+    assert np.array_equal(np.sort(merged.members), np.arange(4 * 92))
+    assert merged.shared == bezier.shared + mesh.shared == 24 + 120
+    # Two entries share a merged group exactly when they shared a group in their own kind.
+    same = lambda g, a, b: g.group_of[a] == g.group_of[b]  # noqa: E731
+    for a, b in rng.integers(0, 48, size=(200, 2)):
+        assert same(merged, a, b) == same(bezier, a, b)
+    slot = lambda t, e: 4 * (12 + t) + e  # noqa: E731
+    for (t, e), (u, f) in rng.integers(0, (80, 3), size=(200, 2, 2)):
+        assert same(merged, slot(t, e), slot(u, f)) == same(mesh, 3 * t + e, 3 * u + f)
+    assert (merged.group_sizes[merged.group_of[[slot(t, 3) for t in range(80)]]] == 1).all()

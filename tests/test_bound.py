@@ -54,3 +54,68 @@ def test_bound_in_screen_space_with_culling(tessellator, rng):
     scene = Scene(patches, np.zeros(150, np.int32), camera, name="random patches")
     tess = check_bound(tessellator, scene, "random patches, 16 px", pixels=16.0, max_factor=512)
     assert 0 < tess.stats["culled"] < 150
+
+
+# --- PN triangles: the surface is the PN patch of each input triangle, at the same (u, v) --------
+
+def check_pn_bound(tessellator, scene, name, eps=None, pixels=None, max_factor=64, sharp_edges="straight"):
+    from cltess.pipeline import PN
+
+    tess = tessellator.tessellate(scene, eps=eps, pixels=pixels, max_factor=max_factor, sharp_edges=sharp_edges)
+    assert tess.stats["saturated"] == 0, "choose a tolerance the factors can meet"
+    controls = reference.pn_control_points(PN.prepare(scene, sharp_edges).source.astype(np.float64))
+    if pixels is not None:
+        eps, culled = reference.pn_tolerances(controls, pixels=pixels, camera=scene.camera)
+        assert np.array_equal(tess.factors[:, 0] == 0, culled)
+    f = tess.factors[:, :3]
+    transition = ((f.min(1) != f.max(1)) & (f.min(1) > 0)).sum()
+    ratio = bound_ratio(controls, tess, eps, surface=reference.pn_surface_points)
+    BOUND_RATIOS[f"PN {name} ({tess.num_triangles} triangles, {transition} with transitions)"] = ratio
+    print(f"PN {name}: worst ratio {ratio:.4f}, {transition} triangles with transition strips")
+    assert ratio <= 1.0
+    assert transition > 0
+    return tess
+
+
+def mesh_scene(mesh, name, camera=None):
+    return Scene.from_trimesh(mesh, camera=camera, name=name)
+
+
+@pytest.mark.parametrize("eps", [1e-2, 1e-3])
+def test_pn_bound_on_an_icosphere(tessellator, eps):
+    from support import icosphere
+
+    check_pn_bound(tessellator, mesh_scene(icosphere(2), "icosphere"), f"icosphere eps={eps}", eps=eps)
+
+
+@pytest.mark.parametrize("eps", [3e-2, 3e-3])
+def test_pn_bound_on_a_torus_and_a_genus_2_mesh(tessellator, eps):
+    from support import genus2, torus
+
+    check_pn_bound(tessellator, mesh_scene(torus(), "torus"), f"torus eps={eps}", eps=eps)
+    check_pn_bound(tessellator, mesh_scene(genus2(), "genus 2"), f"genus-2 eps={eps}", eps=eps)
+
+
+@pytest.mark.parametrize("sharp_edges", ["straight", "average", "keep"])
+def test_pn_bound_on_a_noisy_mesh_with_sharp_edges(tessellator, rng, sharp_edges):
+    """Random vertex noise (factors vary a lot between neighbours: many transitions) and split
+    vertices with perturbed normals (sharp edges), under each sharp-edge choice."""
+    from support import icosphere, split_some_vertices
+
+    mesh = icosphere(2)
+    mesh = type(mesh)(mesh.vertices * rng.uniform(0.8, 1.2, (len(mesh.vertices), 1)), mesh.faces, process=False)
+    mesh = split_some_vertices(rng, mesh, fraction=0.3, noise=0.3)
+    scene = mesh_scene(mesh, "noisy sphere")
+    tess = check_pn_bound(tessellator, scene, f"noisy split sphere eps=0.003 sharp={sharp_edges}", eps=0.003,
+                          sharp_edges=sharp_edges)
+    assert tess.stats["sharp_edges"] > 20
+
+
+def test_pn_bound_in_screen_space_with_culling(tessellator):
+    from support import genus2
+
+    camera = Camera(eye=np.array([2.5, -2.0, 1.5]), target=np.array([2.5, 1.5, 0.5]), fov_y_deg=40,
+                    width=400, height=300)
+    scene = mesh_scene(genus2(), "genus 2", camera)
+    tess = check_pn_bound(tessellator, scene, "genus-2, 0.5 px, camera inside", pixels=0.5, max_factor=256)
+    assert 0 < tess.stats["culled"] < scene.num_patches

@@ -42,3 +42,39 @@ def test_scan_of_a_large_batch(tessellator, rng):
     m, n = factors[:, 0].astype(np.int64), factors[:, 1].astype(np.int64)
     assert np.array_equal(np.diff(vertex_offsets), (m + 1) * (n + 1))
     assert np.array_equal(np.diff(index_offsets), 6 * m * n)
+
+
+def test_pn_counts_and_offsets_match_reference(tessellator, rng):
+    from cltess.pipeline import PN
+    from test_indices import random_triangle_factors
+
+    factors = random_triangle_factors(rng, 1500, high=70)
+    vertex_offsets, index_offsets, _ = tessellator.stage_counts(cl_array.to_device(tessellator.queue, factors),
+                                                                kind=PN)
+    vertex_counts, index_counts = reference.counts(factors, kind="pn")
+    assert np.array_equal(vertex_offsets.get(), reference.offsets(vertex_counts))
+    assert np.array_equal(index_offsets.get(), reference.offsets(index_counts))
+
+
+def test_uniform_triangle_counts(tessellator):
+    from cltess.pipeline import PN
+
+    factors = np.array([[1, 1, 1, 0], [4, 4, 4, 0], [64, 64, 64, 0], [0, 0, 0, 0]], np.int32)
+    vertex_offsets, index_offsets, _ = tessellator.stage_counts(cl_array.to_device(tessellator.queue, factors),
+                                                                kind=PN)
+    assert np.diff(vertex_offsets.get()).tolist() == [3, 15, 65 * 66 // 2, 0]  # (n+1)(n+2)/2
+    assert np.diff(index_offsets.get()).tolist() == [3, 3 * 16, 3 * 64 * 64, 0]  # n^2 triangles
+
+
+def test_counts_of_kinds_side_by_side(tessellator, rng):
+    """A scene's (P, 4) factors hold Bézier patches then PN triangles: one scan over both."""
+    from cltess.pipeline import BEZIER, PN
+    from test_indices import random_triangle_factors
+
+    quads, triangles = random_factors(rng, 300), random_triangle_factors(rng, 500)
+    factors = np.concatenate([quads, triangles])
+    vertex_offsets, index_offsets, _ = tessellator.stage_counts(
+        cl_array.to_device(tessellator.queue, factors), kind=[(BEZIER, 0, 300), (PN, 300, 500)])
+    counts = [np.concatenate(pair) for pair in zip(reference.counts(quads), reference.counts(triangles, kind="pn"))]
+    assert np.array_equal(vertex_offsets.get(), reference.offsets(counts[0]))
+    assert np.array_equal(index_offsets.get(), reference.offsets(counts[1]))

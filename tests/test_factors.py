@@ -66,3 +66,107 @@ def test_zs_steps_keep_the_bound_and_are_at_most_one(d_uu, d_uv, d_vv, c):
     du, dv = reference.zs_steps(d_uu, d_uv, d_vv, c)
     assert 0 < du <= 1 and 0 < dv <= 1, (du, dv)
     assert d_uu * du * du + 2 * d_uv * du * dv + d_vv * dv * dv <= c * (1 + 1e-9)
+
+
+# --- PN triangles: pn_factors derives the control points and the Filip factors ----------------
+
+def device_pn_factors(tessellator, triangles, eps=None, pixels=None, camera=None, max_factor=64):
+    data = cl_array.to_device(tessellator.queue, triangles)
+    controls, factors, flags, _ = tessellator.stage_pn_factors(data, eps, pixels, camera, max_factor)
+    return controls.get(), factors.get(), flags.get()
+
+
+def test_pn_control_points_match_reference(tessellator, rng):
+    from support import random_pn_triangles
+
+    triangles = random_pn_triangles(rng, 2000)
+    controls, _, _ = device_pn_factors(tessellator, triangles, eps=0.1)
+    expected = reference.pn_control_points(triangles.astype(np.float64))
+    scale = np.abs(triangles[:, :3, :3]).max()
+    assert np.abs(controls - expected).max() < 2e-6 * scale
+    # Corners exact, weights 1 for points and 0 for normals; normal field controls unit.
+    assert np.array_equal(controls[:, :3, :3], triangles[:, :3, :3])
+    assert (controls[:, :10, 3] == 1).all() and (controls[:, 10:, 3] == 0).all()
+    assert np.allclose(np.linalg.norm(controls[:, 13:16, :3], axis=2), 1, atol=1e-5)
+
+
+@pytest.mark.parametrize("eps", [0.003, 0.03, 0.3])
+def test_pn_factors_match_reference_on_random_triangles(tessellator, rng, eps):
+    from support import random_pn_triangles
+
+    triangles = random_pn_triangles(rng, 3000)
+    controls, got, flags = device_pn_factors(tessellator, triangles, eps=eps)
+    expected, unclamped, saturated = reference.pn_factors(controls.astype(np.float64), np.full(len(got), eps))
+    assert_factors_match(got[:, :3], expected[:, :3], unclamped)
+    assert (got[:, 3] == 0).all() and (got[:, :3] >= 1).all()
+    assert np.array_equal(flags & 1, saturated.astype(int))
+    assert len(np.unique(got[:, :3])) > 5
+
+
+def test_folded_triangles_get_no_factors(tessellator, rng):
+    """Two corners at one point (reference.pn_folded): factor 0 and flag bit 2."""
+    from support import random_pn_triangles
+
+    triangles = random_pn_triangles(rng, 30)
+    triangles[::3, 1, :3] = triangles[::3, 0, :3]
+    triangles[1::3, 2, :3] = triangles[1::3, 1, :3]
+    controls, got, flags = device_pn_factors(tessellator, triangles, eps=0.01)
+    folded = reference.pn_folded(controls)
+    assert folded.sum() == 20 and (got[folded] == 0).all() and (flags[folded] == 4).all()
+    assert (got[~folded, :3] > 0).all() and not (flags[~folded] & 4).any()
+    assert np.array_equal(reference.pn_factors(controls.astype(np.float64), np.full(30, 0.01))[0] == 0,
+                          np.repeat(folded[:, None], 4, 1) | (np.arange(4) == 3))
+
+
+def test_pn_screen_space_tolerance_and_culling_match_reference(tessellator, rng):
+    from support import random_pn_triangles
+
+    triangles = random_pn_triangles(rng, 3000)
+    camera = Camera(eye=np.array([12.0, 3.0, 1.0]), target=np.zeros(3), fov_y_deg=40)
+    controls, got, flags = device_pn_factors(tessellator, triangles, pixels=0.5, camera=camera, max_factor=4096)
+    eps, culled = reference.pn_tolerances(controls.astype(np.float64), pixels=0.5, camera=camera)
+    expected, unclamped, _ = reference.pn_factors(controls.astype(np.float64), eps, culled, max_factor=4096)
+    assert 0 < culled.sum() < len(triangles)
+    assert np.array_equal((flags & 2) > 0, culled)
+    assert (got[culled] == 0).all()
+    assert_factors_match(got[:, :3], expected[:, :3], unclamped)
+
+
+def test_pn_saturated_triangles_are_flagged_and_clamped(tessellator, rng):
+    from support import random_pn_triangles
+
+    triangles = random_pn_triangles(rng, 500)
+    controls, got, flags = device_pn_factors(tessellator, triangles, eps=1e-4, max_factor=8)
+    _, _, saturated = reference.pn_factors(controls.astype(np.float64), np.full(500, 1e-4), max_factor=8)
+    assert saturated.sum() > 100
+    assert got.max() == 8 and np.array_equal(flags & 1, saturated.astype(int))
+
+
+def test_flat_triangles_and_straight_edges_get_factor_one(tessellator, rng):
+    """Normals equal to the face normal (or zero edge normals: straight edges) make the patch the
+    flat triangle: zero second derivatives (up to float32 rounding), factor 1."""
+    from support import random_pn_triangles
+
+    triangles = random_pn_triangles(rng, 200)
+    corners = triangles[:, :3, :3].astype(np.float64)
+    face = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    face /= np.linalg.norm(face, axis=1, keepdims=True)
+    triangles[:, 3:12, :3] = face[:, None]
+    triangles[100:, 6:12, :3] = 0.0
+    _, got, flags = device_pn_factors(tessellator, triangles, eps=1e-4)
+    assert (got[:, :3] == 1).all() and not flags.any()
+
+
+def test_pn_filip_bound_derivatives_of_a_known_patch():
+    """A patch that is the quadratic map b(u, v, w) = (u, v, u^2): D_{d20, d20} b = (0, 0, 2) for
+    d20 = e_u - e_w, d01 = e_v - e_u gives (0, 0, 2) too and d12 = e_w - e_v gives 0; the bounds
+    are exact for a quadratic (the second-difference controls are all equal)."""
+    # Cubic control points of the polynomial (u, v, u^2) by degree elevation: u^2 = u^2 (u+v+w).
+    controls = np.zeros((1, 16, 4))
+    for k, (i, j, l) in enumerate(reference.CUBIC):
+        u_part = i / 3
+        v_part = j / 3
+        uu = i * (i - 1) / 6  # u^2 in cubic Bernstein form: b_ijk = i (i-1) / 6
+        controls[0, k, :3] = (u_part, v_part, uu)
+    bounds = reference.pn_second_derivative_bounds(controls)[0]
+    assert np.allclose(bounds, [[2, 0, 2], [0, 0, 0], [2, 0, 2]])

@@ -75,9 +75,9 @@ def test_bigguy_loads_fast():
 
 
 def test_unknown_extension_and_missing_file(tmp_path):
-    path = tmp_path / "model.obj"
+    path = tmp_path / "model.xyz"
     path.write_text("v 0 0 0\n")
-    with pytest.raises(SceneError, match=r"model\.obj.*'\.obj'"):
+    with pytest.raises(SceneError, match=r"model\.xyz.*'\.xyz'"):
         load_scene(path)
     with pytest.raises(SceneError, match=r"no_such\.bpt: file not found"):
         load_scene(tmp_path / "no_such.bpt")

@@ -16,11 +16,13 @@ MiB = 2**20
 # plus this much for the plan, allocator slack and the writer's buffers (measured: 31 MiB).
 STATED_OVERHEAD = 40 * MiB
 
-PEAK_RSS = """
-import resource, sys
+PEAK_RSS = r"""
+import re, sys
+from pathlib import Path
 from cltess.cli import main
 code = main(["tessellate"] + sys.argv[1:] + ["-q"])
-print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024)
+# VmHWM, not ru_maxrss: Linux carries ru_maxrss over execve from the parent process.
+print(int(re.search(r"VmHWM:\s+(\d+) kB", Path("/proc/self/status").read_text()).group(1)) * 1024)
 sys.exit(code)
 """
 

