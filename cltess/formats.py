@@ -348,6 +348,8 @@ def read_json_scene(path) -> Scene:
             with np.errstate(over="ignore", invalid="ignore"):  # reported just below
                 patches = patches @ matrix.T  # b' = M b for every homogeneous control point
             _check_transformed(patches, where, f"{key}.transform")
+            if np.linalg.det(matrix[:3, :3]) < 0:  # a mirror: reverse u so t_u x t_v points outwards again
+                patches = patches[:, :, ::-1]
         all_patches.append(patches)
         all_ids.append(np.full(len(patches), object_id, np.int32))
 

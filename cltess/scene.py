@@ -207,7 +207,8 @@ class TriangleMesh:
 
     def transformed(self, matrix: np.ndarray, object_id: int | None = None) -> "TriangleMesh":
         """A copy moved by an affine row-major 4x4 ``matrix`` (last row 0 0 0 1; ValueError else):
-        positions ``M p``, normals by the inverse transpose of its 3x3, unit length again."""
+        positions ``M p``, normals by the inverse transpose of its 3x3, unit length again; a
+        mirroring matrix (negative determinant) also reverses each face's winding."""
         matrix = np.asarray(matrix, np.float64)
         if not np.array_equal(matrix[3], [0.0, 0.0, 0.0, 1.0]):
             raise ValueError("a mesh takes only affine transforms (last row 0 0 0 1)")
@@ -218,6 +219,8 @@ class TriangleMesh:
         bad = ~np.isfinite(out.vertices).all(axis=1)
         if bad.any():
             raise ValueError(f"vertex {int(np.argmax(bad))}: not finite after the transform")
+        if np.linalg.det(matrix[:3, :3]) < 0:  # a mirror: keep the winding with the normals
+            out.faces = self.faces[:, ::-1].copy()
         if object_id is not None:
             out.object_id = int(object_id)
         return out

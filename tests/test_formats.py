@@ -518,3 +518,31 @@ def test_tea_table_scene():
         for b in range(a + 1, len(boxes)):
             (la, ha), (lb, hb) = boxes[a], boxes[b]
             assert (ha[:2] < lb[:2]).any() or (hb[:2] < la[:2]).any(), (a + 1, b + 1)
+
+
+def test_a_mirroring_transform_keeps_patches_facing_outwards(tmp_path):
+    """x -> -x turns the sphere inside out unless u is reversed: normals must still point out."""
+    import json
+
+    from cltess.reference import evaluate
+
+    sphere = Path(__file__).resolve().parent.parent / "scenes" / "sphere.bpt"
+    (tmp_path / "sphere.bpt").write_bytes(sphere.read_bytes())
+    mirror = [[-1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]
+    (tmp_path / "s.json").write_text(json.dumps({"objects": [{"file": "sphere.bpt", "transform": mirror}]}))
+    scene = load_scene(tmp_path / "s.json")
+    for patch in scene.patches:
+        position, normal = evaluate(patch, [0.3, 0.6], [0.4, 0.7])
+        assert ((position * normal).sum(axis=1) > 0.99).all()
+
+
+def test_a_mirroring_transform_reverses_mesh_winding():
+    import trimesh
+
+    from cltess.scene import TriangleMesh
+
+    mesh = TriangleMesh.from_trimesh(trimesh.creation.icosphere(1))
+    mirrored = mesh.transformed(np.diag([-1.0, 1.0, 1.0, 1.0]))
+    corners = mirrored.vertices[mirrored.faces]
+    face_normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    assert ((face_normals * corners.mean(axis=1)).sum(axis=1) > 0).all()
