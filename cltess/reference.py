@@ -280,8 +280,10 @@ def homogeneous_and_derivatives(patch: np.ndarray, u: np.ndarray, v: np.ndarray)
 def evaluate(patch: np.ndarray, u, v) -> tuple[np.ndarray, np.ndarray]:
     """Positions and unit normals (N, 3) of a (4, 4, 4) rational patch at (u, v) (N,).
 
-    Normal ``t_u x t_v`` with ``t_u = (B_u.xyz - B_u.w p) / B.w``.  Where it vanishes (a
-    collapsed edge), the normal is taken a little way inside the domain (the limit direction).
+    Normal ``T_u x T_v`` with ``T_u = B_u.xyz - B_u.w p`` (t_u up to the factor 1/B.w).  Where
+    it (nearly) vanishes, at a collapsed edge, the normal is its first-order term towards the
+    domain centre d = (1/2 - u, 1/2 - v) (``limit_normal``); if that vanishes too, the normal a
+    step inside; else +z.
     """
     u, v = np.atleast_1d(np.asarray(u, float)), np.atleast_1d(np.asarray(v, float))
     b, b_u, b_v = homogeneous_and_derivatives(patch, u, v)
@@ -289,10 +291,42 @@ def evaluate(patch: np.ndarray, u, v) -> tuple[np.ndarray, np.ndarray]:
     normal = _normal(b, b_u, b_v)
     bad = ~_normal_ok(normal, b, b_u, b_v)
     if bad.any():
+        limit = limit_normal(patch, u[bad], v[bad], b[bad], b_u[bad], b_v[bad])
+        stronger = (limit * limit).sum(1) > (normal[bad] * normal[bad]).sum(1)
         us, vs = u[bad] + NORMAL_SHIFT * (0.5 - u[bad]), v[bad] + NORMAL_SHIFT * (0.5 - v[bad])
-        normal[bad] = _normal(*homogeneous_and_derivatives(patch, us, vs))
+        inside = _normal(*homogeneous_and_derivatives(patch, us, vs))
+        normal[bad] = np.where(stronger[:, None], limit, inside)
     length = np.linalg.norm(normal, axis=1, keepdims=True)
     return position, np.where(length > 0, normal / np.where(length > 0, length, 1), [0.0, 0.0, 1.0])
+
+
+def limit_normal(patch, u, v, b, b_u, b_v) -> np.ndarray:
+    """D_d(T_u x T_v) = D_d T_u x T_v + T_u x D_d T_v, d = (1/2 - u, 1/2 - v), at (u, v) (N,).
+
+    With D_d p = (d_u T_u + d_v T_v) / B.w.  Where T_u x T_v vanishes on a collapsed edge this is
+    the direction the normal tends to (DESIGN.md section 2, "the next-order term")."""
+    s = 1 - u
+    lin_u, lin_v = np.stack([s, u], -1), np.stack([1 - v, v], -1)
+    d2u = patch[:, 2:] - 2 * patch[:, 1:-1] + patch[:, :-2]                       # (4, 2, 4)
+    d2v = patch[2:] - 2 * patch[1:-1] + patch[:-2]                                # (2, 4, 4)
+    duv = patch[1:, 1:] - patch[1:, :-1] - patch[:-1, 1:] + patch[:-1, :-1]       # (3, 3, 4)
+    b_uu = 6 * np.einsum("nj,ni,jic->nc", bernstein3(v), lin_u, d2u)
+    b_vv = 6 * np.einsum("nj,ni,jic->nc", lin_v, bernstein3(u), d2v)
+    b_uv = 9 * np.einsum("nj,ni,jic->nc", bernstein2(v), bernstein2(u), duv)
+    d_u, d_v = (0.5 - u)[:, None], (0.5 - v)[:, None]
+    p = b[:, :3] / b[:, 3:]
+    t_u, t_v = b_u[:, :3] - b_u[:, 3:] * p, b_v[:, :3] - b_v[:, 3:] * p
+    dp = (d_u * t_u + d_v * t_v) / b[:, 3:]
+    ds_u, ds_v = d_u * b_uu + d_v * b_uv, d_u * b_uv + d_v * b_vv
+    dt_u = ds_u[:, :3] - ds_u[:, 3:] * p - b_u[:, 3:] * dp
+    dt_v = ds_v[:, :3] - ds_v[:, 3:] * p - b_v[:, 3:] * dp
+    return np.cross(dt_u, t_v) + np.cross(t_u, dt_v)
+
+
+def bernstein2(t: np.ndarray) -> np.ndarray:
+    """(..., 3) quadratic Bernstein basis."""
+    s = 1 - t
+    return np.stack([s * s, 2 * t * s, t * t], axis=-1)
 
 
 def surface_points(patches: np.ndarray, patch_ids: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -302,7 +336,7 @@ def surface_points(patches: np.ndarray, patch_ids: np.ndarray, u: np.ndarray, v:
     return b[:, :3] / b[:, 3:]
 
 
-NORMAL_SHIFT = 1.0e-3  # how far towards the domain centre a vanishing normal is re-evaluated
+NORMAL_SHIFT = 1.0e-3  # the last resort: how far towards the domain centre a normal is re-evaluated
 
 
 def _normal(b, b_u, b_v):
@@ -320,7 +354,8 @@ def _normal_ok(normal, b, b_u, b_v):
     return (normal * normal).sum(1) > NORMAL_DEGENERATE ** 2 * scale * scale
 
 
-NORMAL_DEGENERATE = 1.0e-5  # |t_u x t_v| below this times |t_u|^2 + |t_v|^2 counts as vanished
+NORMAL_DEGENERATE = 1.0e-3  # |T_u x T_v| below this times |T_u|^2 + |T_v|^2: use limit_normal
+PN_NORMAL_VANISHES = 1.0e-5  # a PN normal field shorter than this has no direction
 
 
 # --- stages 4 and 5: the whole tessellation --------------------------------------------------
@@ -596,7 +631,7 @@ def pn_evaluate(controls: np.ndarray, u, v) -> tuple[np.ndarray, np.ndarray]:
     normal = quadratic @ controls[10:16, :3]
     face = _unit_or_zero(np.cross(controls[1, :3] - controls[0, :3], controls[2, :3] - controls[0, :3]))
     fallback = face if (face != 0).any() else np.array([0.0, 0.0, 1.0])
-    ok = (normal * normal).sum(1) > NORMAL_DEGENERATE ** 2
+    ok = (normal * normal).sum(1) > PN_NORMAL_VANISHES ** 2
     return position, np.where(ok[:, None], _unit_or_zero(normal), fallback)
 
 

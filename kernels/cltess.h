@@ -19,7 +19,8 @@
 #pragma OPENCL FP_CONTRACT OFF
 
 #define NORMAL_SHIFT 1.0e-3f     /* reference.NORMAL_SHIFT */
-#define NORMAL_DEGENERATE 1.0e-5f /* reference.NORMAL_DEGENERATE */
+#define NORMAL_DEGENERATE 1.0e-3f /* reference.NORMAL_DEGENERATE */
+#define PN_NORMAL_VANISHES 1.0e-5f /* reference.PN_NORMAL_VANISHES */
 
 /* --- Bernstein bases ------------------------------------------------------------------------ */
 
@@ -47,6 +48,23 @@ inline void load_patch(__global const float4 *patches, uint p, float4 b[16])
 }
 
 /* --- rational patch evaluation (DESIGN.md section 2) ----------------------------------------- */
+
+/* The patch moved so that its control points' bounding box is centred on the origin:
+ * t[k] = (b.xyz - b.w c, b.w).  Returns c.  Tangents t = B_u.xyz - B_u.w p cancel in float32 when
+ * |p| is large against the patch; about its own centre they do not (a sphere at (20, 20, 20)
+ * had 1% of its normals flipped near the poles before this). */
+inline float3 centred_patch(const float4 b[16], float4 t[16])
+{
+    float3 lo = b[0].xyz / b[0].w, hi = lo;
+    for (int k = 1; k < 16; ++k) {
+        lo = min(lo, b[k].xyz / b[k].w);
+        hi = max(hi, b[k].xyz / b[k].w);
+    }
+    float3 centre = 0.5f * (lo + hi);
+    for (int k = 0; k < 16; ++k)
+        t[k] = (float4)(b[k].xyz - b[k].w * centre, b[k].w);
+    return centre;
+}
 
 /* Collapse the patch to the row v = const: cubic controls c[i] of B(., v) and d[i] of B_v(., v).
  * Derivatives use differences of control points, so a collapsed edge gives exactly zero. */
@@ -88,15 +106,57 @@ inline float3 tangent_cross(float4 s, float4 s_u, float4 s_v, int *ok)
     return n;
 }
 
-/* Unit normal at (u, v), given B, B_u, B_v there.  At a collapsed edge t_u x t_v vanishes; the
- * normal is then taken a little way towards the domain centre, where it tends to the limit. */
+/* Second derivatives B_uu, B_uv, B_vv at (u, v), from second differences of the controls. */
+inline void surface_second(const float4 b[16], float u, float v, float4 *s_uu, float4 *s_uv, float4 *s_vv)
+{
+    float4 c[4], d[4], e[4];
+    float bu[4], du[3], bv[2];
+    row_controls(b, v, c, d);
+    bernstein3(u, bu);
+    bernstein2(u, du);
+    bv[0] = 1.0f - v;
+    bv[1] = v;
+    for (int i = 0; i < 4; ++i)  /* controls of B_vv along the row */
+        e[i] = 6.0f * (bv[0] * (b[8 + i] - 2.0f * b[4 + i] + b[i])
+                       + bv[1] * (b[12 + i] - 2.0f * b[8 + i] + b[4 + i]));
+    *s_uu = 6.0f * ((1.0f - u) * (c[2] - 2.0f * c[1] + c[0]) + u * (c[3] - 2.0f * c[2] + c[1]));
+    *s_uv = 3.0f * (du[0] * (d[1] - d[0]) + du[1] * (d[2] - d[1]) + du[2] * (d[3] - d[2]));
+    *s_vv = bu[0] * e[0] + bu[1] * e[1] + bu[2] * e[2] + bu[3] * e[3];
+}
+
+/* Where t_u x t_v vanishes (a collapsed edge), the normal is its first-order term towards the
+ * domain centre, d = (1/2 - u, 1/2 - v): D_d(T_u x T_v) = D_d T_u x T_v + T_u x D_d T_v with
+ * T = B_d.xyz - B_d.w p and D_d p = (d_u T_u + d_v T_v) / B.w (DESIGN.md section 2: "the
+ * next-order term").  Second derivatives, not a step inwards: the edge's own float32 noise
+ * (its control points are only nearly equal once far from the origin) stays negligible. */
+inline float3 limit_normal(const float4 b[16], float u, float v, float4 s, float4 s_u, float4 s_v)
+{
+    float4 s_uu, s_uv, s_vv;
+    surface_second(b, u, v, &s_uu, &s_uv, &s_vv);
+    float d_u = 0.5f - u, d_v = 0.5f - v;
+    float3 p = s.xyz / s.w;
+    float3 t_u = s_u.xyz - s_u.w * p, t_v = s_v.xyz - s_v.w * p;
+    float3 dp = (d_u * t_u + d_v * t_v) / s.w;
+    float4 ds_u = d_u * s_uu + d_v * s_uv, ds_v = d_u * s_uv + d_v * s_vv;
+    float3 dt_u = ds_u.xyz - ds_u.w * p - s_u.w * dp;
+    float3 dt_v = ds_v.xyz - ds_v.w * p - s_v.w * dp;
+    return cross(dt_u, t_v) + cross(t_u, dt_v);
+}
+
+/* Unit normal at (u, v), given B, B_u, B_v there: t_u x t_v, or at a collapsed edge its limit
+ * (limit_normal); if that vanishes too, a step towards the centre; else +z. */
 inline float3 surface_normal(const float4 b[16], float u, float v, float4 s, float4 s_u, float4 s_v)
 {
     int ok;
     float3 n = tangent_cross(s, s_u, s_v, &ok);
     if (!ok) {
-        surface_eval(b, u + NORMAL_SHIFT * (0.5f - u), v + NORMAL_SHIFT * (0.5f - v), &s, &s_u, &s_v);
-        n = tangent_cross(s, s_u, s_v, &ok);
+        float3 limit = limit_normal(b, u, v, s, s_u, s_v);
+        if (dot(limit, limit) > dot(n, n)) {
+            n = limit;
+        } else {
+            surface_eval(b, u + NORMAL_SHIFT * (0.5f - u), v + NORMAL_SHIFT * (0.5f - v), &s, &s_u, &s_v);
+            n = tangent_cross(s, s_u, s_v, &ok);
+        }
     }
     float len = length(n);
     return len > 0.0f ? n / len : (float3)(0.0f, 0.0f, 1.0f);
@@ -412,7 +472,7 @@ inline float3 pn_normal_field(const float4 b[16], float3 t)
 /* The unit normal from the normal field; where it vanishes, the flat triangle's normal. */
 inline float3 pn_unit_normal(const float4 b[16], float3 n)
 {
-    if (dot3(n, n) > NORMAL_DEGENERATE * NORMAL_DEGENERATE)
+    if (dot3(n, n) > PN_NORMAL_VANISHES * PN_NORMAL_VANISHES)
         return unit_or_zero(n);
     float3 face = unit_or_zero(cross(b[1].xyz - b[0].xyz, b[2].xyz - b[0].xyz));
     return dot3(face, face) > 0.0f ? face : (float3)(0.0f, 0.0f, 1.0f);

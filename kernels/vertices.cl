@@ -68,11 +68,13 @@ __kernel void quad_vertices(__global const float4 *patches, __global const int4 
         return;
     vertex_out out = {positions, normals, uvs, patch_ids, object_ids};
     int object = patch_objects[p];
-    float4 b[16];
+    float4 b[16], t[16];
     load_patch(patches, p - patch_base, b);
+    float3 centre = centred_patch(b, t);  /* the surface is evaluated about its centre, t */
     ulong at = vertex_offsets[p] - vertex_base;
 
-    /* The boundary ring, counter-clockwise from (0, 0). */
+    /* The boundary ring, counter-clockwise from (0, 0): positions canonical from the edge's own
+     * control points (bitwise equal to the neighbour's), normals from the centred patch. */
     for (int e = 0; e < 4; ++e) {
         float4 c[4];
         edge_controls(b, e, c);
@@ -81,8 +83,8 @@ __kernel void quad_vertices(__global const float4 *patches, __global const int4 
             float4 h = boundary_point(c, k, fe);
             float2 uv = edge_uv(e, k, fe);
             float4 s, s_u, s_v;
-            surface_eval(b, uv.x, uv.y, &s, &s_u, &s_v);
-            put_vertex(out, at++, h.xyz / h.w, surface_normal(b, uv.x, uv.y, s, s_u, s_v), uv, p, object);
+            surface_eval(t, uv.x, uv.y, &s, &s_u, &s_v);
+            put_vertex(out, at++, h.xyz / h.w, surface_normal(t, uv.x, uv.y, s, s_u, s_v), uv, p, object);
         }
     }
 
@@ -95,7 +97,7 @@ __kernel void quad_vertices(__global const float4 *patches, __global const int4 
         /* Along the row v = const, B is a cubic in u with controls c, B_v one with controls d,
          * and B_u the derivative of B (DESIGN.md section 6). */
         float4 c[4], d[4], a[4], av[4], s[4], s_u[4], s_v[4];
-        row_controls(b, v, c, d);
+        row_controls(t, v, c, d);
         power_form(c, a);
         power_form(d, av);
         cubic_differences(a[0], a[1], a[2], a[3], h, s);
@@ -112,9 +114,9 @@ __kernel void quad_vertices(__global const float4 *patches, __global const int4 
                 du = s_u[0];
                 dv = s_v[0];
             } else {
-                surface_eval(b, u, v, &value, &du, &dv);
+                surface_eval(t, u, v, &value, &du, &dv);
             }
-            put_vertex(out, at++, value.xyz / value.w, surface_normal(b, u, v, value, du, dv),
+            put_vertex(out, at++, value.xyz / value.w + centre, surface_normal(t, u, v, value, du, dv),
                        (float2)(u, v), p, object);
         }
     }
