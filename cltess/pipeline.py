@@ -288,7 +288,7 @@ class Tessellator:
         for kind in KINDS:
             count = kind.count(scene)
             if count:
-                host = kind.prepare(scene, sharp_edges)
+                host = scene.prepared((kind.name, sharp_edges), lambda: kind.prepare(scene, sharp_edges))
                 parts.append(PlanPart(kind, base, count, kind.upload(self.queue, host.source)))
                 inputs.append(host)
                 base += count

@@ -173,7 +173,7 @@ class TriangleMesh:
             f, c = (int(x) for x in np.argwhere(out)[0])
             raise SceneError(f"{name}: face {f}: vertex index {int(faces[f, c])} out of range "
                              f"0..{len(vertices) - 1}")
-        self.vertices, self.faces = vertices, faces
+        self.vertices, self.faces = vertices.copy(), faces.copy()  # owned: made read-only below
         if self.object_id is None or not 0 <= int(self.object_id) <= 2**31 - 1:
             raise SceneError(f"{name}: object id {self.object_id!r} is not in 0..2**31-1")
         self.object_id = int(self.object_id)
@@ -200,6 +200,7 @@ class TriangleMesh:
                 normals[bad] = computed[bad]
             self.repaired_normals = int(bad.sum())
         self.normals = normals
+        _read_only(self.vertices, self.faces, self.normals)
 
     @property
     def num_faces(self) -> int:
@@ -235,6 +236,11 @@ class TriangleMesh:
                             name or str(getattr(mesh, "metadata", {}).get("file_name", "<trimesh>")))
 
 
+def _read_only(*arrays: np.ndarray) -> None:
+    for array in arrays:
+        array.setflags(write=False)
+
+
 @dataclass
 class Scene:
     """Rational bicubic Bézier patches and triangle meshes ready for the pipeline.
@@ -255,17 +261,35 @@ class Scene:
     meshes: list = field(default_factory=list)
 
     def __post_init__(self) -> None:
-        self.patches = np.ascontiguousarray(self.patches, dtype=np.float64)
-        self.object_ids = np.ascontiguousarray(self.object_ids, dtype=np.int32)
+        # Owned, read-only copies: what the pipeline derives from them (adjacency, uploads) is
+        # cached per scene (``prepared``), so they must not change under it.
+        self.patches = np.array(self.patches, dtype=np.float64, order="C")
+        self.object_ids = np.array(self.object_ids, dtype=np.int32, order="C")
         if self.patches.size == 0 and self.patches.shape[1:] != (4, 4, 4):
             self.patches = self.patches.reshape(0, 4, 4, 4)
         if self.patches.ndim != 4 or self.patches.shape[1:] != (4, 4, 4):
             raise SceneError(f"{self.name}: patches must have shape (P, 4, 4, 4), got {self.patches.shape}")
         if self.object_ids.shape != (len(self.patches),):
             raise SceneError(f"{self.name}: need one object id per patch")
-        self.meshes = list(self.meshes)
+        self.meshes = tuple(self.meshes)
         if not all(isinstance(mesh, TriangleMesh) for mesh in self.meshes):
             raise SceneError(f"{self.name}: meshes must be TriangleMesh objects")
+        _read_only(self.patches, self.object_ids)
+        self._prepared: dict = {}
+
+    def prepared(self, key, make):
+        """``make()``, computed once per key while the scene's arrays stay the same objects.
+
+        The pipeline keeps each patch kind's host input here (adjacency, float32 copies), so
+        tessellating a scene again (another tolerance, a camera move) skips that work.  The
+        arrays are read-only; assigning new ones starts afresh.
+        """
+        identity = (id(self.patches), id(self.object_ids),
+                    tuple((id(m.vertices), id(m.faces), id(m.normals), m.object_id) for m in self.meshes))
+        cached = self._prepared.get(key)
+        if cached is None or cached[0] != identity:
+            cached = self._prepared[key] = (identity, make())
+        return cached[1]
 
     @property
     def num_patches(self) -> int:

@@ -119,3 +119,24 @@ def test_normals_at_collapsed_edges_far_from_the_origin(tessellator, centre):
     error = np.linalg.norm(tess.normals - outwards, axis=1)
     print(f"sphere at {centre}: worst normal error {error.max():.1e}")
     assert error.max() < 0.01
+
+
+def test_a_scene_is_prepared_once_and_cannot_change_under_its_cache(tessellator, monkeypatch):
+    """Adjacency and uploads are cached on the scene (the benchmark found them dominating end
+    to end); the arrays they come from are read-only, so the cache cannot go stale."""
+    from cltess import pipeline
+
+    calls = []
+    real = pipeline.edge_groups
+    monkeypatch.setattr(pipeline, "edge_groups", lambda patches: calls.append(1) or real(patches))
+    scene = load_scene(SCENES / "teapot.bez")
+    first = tessellator.tessellate(scene, eps=0.01)
+    second = tessellator.tessellate(scene, eps=0.002)
+    assert len(calls) == 1 and second.num_triangles > first.num_triangles
+    with pytest.raises(ValueError, match="read-only"):
+        scene.patches[0, 0, 0, 0] = 1.0
+    moved = scene.patches.copy()
+    moved[..., 2] += moved[..., 3]  # z + 1 for every control point
+    scene.patches = moved  # new arrays: prepared afresh
+    third = tessellator.tessellate(scene, eps=0.01)
+    assert len(calls) == 2 and np.allclose(third.positions[:, 2], first.positions[:, 2] + 1, atol=1e-5)
