@@ -484,8 +484,14 @@ def numpy_evaluate(patches: np.ndarray, patch_ids: np.ndarray, uv: np.ndarray,
         v = uv[start:stop, 1].astype(dtype)
         b, b_u, b_v = _evaluate_chunk(grid, u, v)
         p, n, ok = _normals(b, b_u, b_v)
-        for k in np.flatnonzero(~ok):  # collapsed edges: rare, one at a time, as the reference does
-            n[k] = reference.evaluate(grid[k], u[k:k + 1], v[k:k + 1])[1][0]
+        bad = np.flatnonzero(~ok)
+        if len(bad):  # collapsed edges: the reference's rule (reference.evaluate), vectorised
+            limit = reference.limit_normal(grid[bad], u[bad], v[bad], b[bad], b_u[bad], b_v[bad])
+            stronger = (limit * limit).sum(1) > (n[bad] * n[bad]).sum(1)
+            shift = dtype(reference.NORMAL_SHIFT)
+            us, vs = u[bad] + shift * (dtype(0.5) - u[bad]), v[bad] + shift * (dtype(0.5) - v[bad])
+            _, inside, _ = _normals(*_evaluate_chunk(grid[bad], us, vs))
+            n[bad] = np.where(stronger[:, None], limit, inside)
         length = np.sqrt((n * n).sum(1, keepdims=True))
         positions[start:stop] = p
         normals[start:stop] = n / np.where(length > 0, length, 1)

@@ -304,15 +304,16 @@ def limit_normal(patch, u, v, b, b_u, b_v) -> np.ndarray:
     """D_d(T_u x T_v) = D_d T_u x T_v + T_u x D_d T_v, d = (1/2 - u, 1/2 - v), at (u, v) (N,).
 
     With D_d p = (d_u T_u + d_v T_v) / B.w.  Where T_u x T_v vanishes on a collapsed edge this is
-    the direction the normal tends to (DESIGN.md section 2, "the next-order term")."""
-    s = 1 - u
-    lin_u, lin_v = np.stack([s, u], -1), np.stack([1 - v, v], -1)
-    d2u = patch[:, 2:] - 2 * patch[:, 1:-1] + patch[:, :-2]                       # (4, 2, 4)
-    d2v = patch[2:] - 2 * patch[1:-1] + patch[:-2]                                # (2, 4, 4)
-    duv = patch[1:, 1:] - patch[1:, :-1] - patch[:-1, 1:] + patch[:-1, :-1]       # (3, 3, 4)
-    b_uu = 6 * np.einsum("nj,ni,jic->nc", bernstein3(v), lin_u, d2u)
-    b_vv = 6 * np.einsum("nj,ni,jic->nc", lin_v, bernstein3(u), d2v)
-    b_uv = 9 * np.einsum("nj,ni,jic->nc", bernstein2(v), bernstein2(u), duv)
+    the direction the normal tends to (DESIGN.md section 2, "the next-order term").
+    patch: one (4, 4, 4) patch, or (N, 4, 4, 4), one per sample."""
+    patch = np.broadcast_to(patch, (len(u), 4, 4, 4))
+    lin_u, lin_v = np.stack([1 - u, u], -1), np.stack([1 - v, v], -1)
+    d2u = patch[:, :, 2:] - 2 * patch[:, :, 1:-1] + patch[:, :, :-2]                      # (N, 4, 2, 4)
+    d2v = patch[:, 2:] - 2 * patch[:, 1:-1] + patch[:, :-2]                               # (N, 2, 4, 4)
+    duv = patch[:, 1:, 1:] - patch[:, 1:, :-1] - patch[:, :-1, 1:] + patch[:, :-1, :-1]   # (N, 3, 3, 4)
+    b_uu = 6 * np.einsum("nj,ni,njic->nc", bernstein3(v), lin_u, d2u)
+    b_vv = 6 * np.einsum("nj,ni,njic->nc", lin_v, bernstein3(u), d2v)
+    b_uv = 9 * np.einsum("nj,ni,njic->nc", bernstein2(v), bernstein2(u), duv)
     d_u, d_v = (0.5 - u)[:, None], (0.5 - v)[:, None]
     p = b[:, :3] / b[:, 3:]
     t_u, t_v = b_u[:, :3] - b_u[:, 3:] * p, b_v[:, :3] - b_v[:, 3:] * p
