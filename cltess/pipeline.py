@@ -301,8 +301,8 @@ class Tessellator:
         for part in parts:
             events["factors"] += self._factors(part.kind, part.data, eps, pixels, camera, max_factor,
                                                factors, flags, part.base)
-        groups = merge_edge_groups([(host.groups, part.kind.edges, part.base) for host, part in zip(inputs, parts)],
-                                   count, FACTOR_SLOTS)
+        groups = scene.prepared(("edge groups", sharp_edges), lambda: merge_edge_groups(
+            [(host.groups, part.kind.edges, part.base) for host, part in zip(inputs, parts)], count, FACTOR_SLOTS))
         final, events["crack_free"] = self.stage_crack_free(factors, groups)
         vertex_offsets, index_offsets, events["counts"] = self.stage_counts(
             final, [(part.kind, part.base, part.count) for part in parts])
