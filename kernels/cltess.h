@@ -47,6 +47,18 @@ inline void load_patch(__global const float4 *patches, uint p, float4 b[16])
         b[k] = patches[16 * p + k];
 }
 
+/* Stages 4 and 5 run on one batch of patches, first_patch .. first_patch + num_patches - 1
+ * (scene numbering).  Sets this work-item's patch p and its factors f; 0 when it has nothing
+ * to emit (past the batch's end, or culled). */
+inline int batch_patch(uint first_patch, uint num_patches, __global const int4 *factors, uint *p, int4 *f)
+{
+    if (get_global_id(0) >= num_patches)
+        return 0;
+    *p = first_patch + (uint)get_global_id(0);
+    *f = factors[*p];
+    return f->s0 > 0;
+}
+
 /* --- rational patch evaluation (DESIGN.md section 2) ----------------------------------------- */
 
 /* The patch moved so that its control points' bounding box is centred on the origin:

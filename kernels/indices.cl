@@ -9,18 +9,18 @@ __kernel void quad_indices(__global const int4 *factors, __global const ulong *v
                            __global const ulong *index_offsets, uint first_patch, uint num_patches,
                            ulong index_base, __global uint *indices)
 {
-    if (get_global_id(0) >= num_patches)
-        return;
-    uint p = first_patch + (uint)get_global_id(0);
-    quad_triangles(factors[p], indices + (index_offsets[p] - index_base), (uint)vertex_offsets[p]);
+    uint p;
+    int4 f;
+    if (batch_patch(first_patch, num_patches, factors, &p, &f))
+        quad_triangles(f, indices + (index_offsets[p] - index_base), (uint)vertex_offsets[p]);
 }
 
 __kernel void pn_indices(__global const int4 *factors, __global const ulong *vertex_offsets,
                          __global const ulong *index_offsets, uint first_patch, uint num_patches,
                          ulong index_base, __global uint *indices)
 {
-    if (get_global_id(0) >= num_patches)
-        return;
-    uint p = first_patch + (uint)get_global_id(0);
-    tri_triangles(factors[p], indices + (index_offsets[p] - index_base), (uint)vertex_offsets[p]);
+    uint p;
+    int4 f;
+    if (batch_patch(first_patch, num_patches, factors, &p, &f))
+        tri_triangles(f, indices + (index_offsets[p] - index_base), (uint)vertex_offsets[p]);
 }

@@ -60,11 +60,9 @@ __kernel void quad_vertices(__global const float4 *patches, __global const int4 
                             __global float *positions, __global float *normals, __global float *uvs,
                             __global int *patch_ids, __global int *object_ids)
 {
-    if (get_global_id(0) >= num_patches)
-        return;
-    uint p = first_patch + (uint)get_global_id(0);
-    int4 f = factors[p];
-    if (f.s0 <= 0)
+    uint p;
+    int4 f;
+    if (!batch_patch(first_patch, num_patches, factors, &p, &f))
         return;
     vertex_out out = {positions, normals, uvs, patch_ids, object_ids};
     int object = patch_objects[p];
@@ -138,11 +136,9 @@ __kernel void pn_vertices(__global const float4 *controls, __global const int4 *
                           __global float *positions, __global float *normals, __global float *uvs,
                           __global int *patch_ids, __global int *object_ids)
 {
-    if (get_global_id(0) >= num_patches)
-        return;
-    uint p = first_patch + (uint)get_global_id(0);
-    int4 f = factors[p];
-    if (f.s0 <= 0)
+    uint p;
+    int4 f;
+    if (!batch_patch(first_patch, num_patches, factors, &p, &f))
         return;
     vertex_out out = {positions, normals, uvs, patch_ids, object_ids};
     int object = patch_objects[p];

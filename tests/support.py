@@ -2,11 +2,29 @@
 watertightness checks."""
 from __future__ import annotations
 
+import importlib.util
+import os
+from pathlib import Path
+
 import numpy as np
 import trimesh
 
 from cltess.reference import surface_points
 from cltess.scene import Scene
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENES = ROOT / "scenes"
+# The data handed to the project (../shared/data beside the checkout); tests that need it skip
+# when it is absent.  CLTESS_DATA overrides, as for the benchmarks.
+DATA = Path(os.environ.get("CLTESS_DATA", ROOT.parent / "shared" / "data"))
+
+
+def load_make_scenes():
+    """scenes/make_scenes.py as a module (it is a script, not part of the package)."""
+    spec = importlib.util.spec_from_file_location("make_scenes", SCENES / "make_scenes.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
 def random_patches(rng: np.random.Generator, count: int, spread: float = 5.0) -> np.ndarray:

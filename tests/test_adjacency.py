@@ -2,9 +2,7 @@
 the exact sphere, hand-made grids and random re-orderings of grids."""
 from __future__ import annotations
 
-import importlib.util
 import time
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,20 +12,9 @@ from hypothesis import strategies as st
 from cltess.adjacency import EdgeGroups, edge_groups
 from cltess.formats import load_scene
 from cltess.scene import boundary_curves
+from support import DATA, SCENES, load_make_scenes
 
-ROOT = Path(__file__).resolve().parents[1]
-SCENES = ROOT / "scenes"
-DATA = Path("/work/shared/data")
-
-
-def _make_scenes():
-    spec = importlib.util.spec_from_file_location("make_scenes", SCENES / "make_scenes.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-make_scenes = _make_scenes()
+make_scenes = load_make_scenes()
 
 
 def check_invariants(groups: EdgeGroups, patches: np.ndarray) -> None:
@@ -91,7 +78,7 @@ def test_teapot_open_edges():
     assert edges == sorted(body_rim + handle_ends + spout_ends + lid_top + lid_rim + bottom_centre)
 
 
-@pytest.mark.skipif(not (DATA / "bigguy.bez").exists(), reason="bigguy.bez not in /work/shared/data")
+@pytest.mark.skipif(not (DATA / "bigguy.bez").exists(), reason="bigguy.bez not in the shared data folder")
 def test_bigguy_by_position():
     """bigguy's patches share no vertex indices: adjacency comes from equal positions.
     It holds 344 exact duplicate patches (the non-manifold groups and same-direction pairs);

@@ -1,7 +1,6 @@
 """Scene readers and writers (cltess/formats.py) and the generated scenes (scenes/make_scenes.py)."""
 from __future__ import annotations
 
-import importlib.util
 import json
 import time
 from pathlib import Path
@@ -15,20 +14,9 @@ from hypothesis.extra.numpy import arrays
 from cltess import formats
 from cltess.formats import load_scene, write_bez, write_bpt
 from cltess.scene import SceneError
+from support import DATA, SCENES, load_make_scenes
 
-ROOT = Path(__file__).resolve().parents[1]
-SCENES = ROOT / "scenes"
-DATA = Path("/work/shared/data")
-
-
-def _make_scenes():
-    spec = importlib.util.spec_from_file_location("make_scenes", SCENES / "make_scenes.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-make_scenes = _make_scenes()
+make_scenes = load_make_scenes()
 
 
 # ----------------------------------------------------------------------------- shipped files
@@ -64,7 +52,7 @@ def test_teapot_bpt_equals_bez():
     assert bpt[0, 1, 0].tolist() == [1.3375, 0.0, 2.53125, 1.0]
 
 
-@pytest.mark.skipif(not (DATA / "bigguy.bez").exists(), reason="bigguy.bez not in /work/shared/data")
+@pytest.mark.skipif(not (DATA / "bigguy.bez").exists(), reason="bigguy.bez not in the shared data folder")
 def test_bigguy_loads_fast():
     start = time.perf_counter()
     scene = load_scene(DATA / "bigguy.bez")
