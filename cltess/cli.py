@@ -196,26 +196,26 @@ def cmd_tessellate(args) -> int:
 
     tessellator = Tessellator(device=device)
     mesh_options = {"sharp_edges": args.sharp_edges} if scene.meshes else {}
-    tess = tessellate_to_file(tessellator, scene, output, max_memory_bytes=args.max_memory, eps=args.eps,
-                              pixels=args.pixels, max_factor=args.max_factor,
-                              forward_differencing=not args.no_fd, **mesh_options)
-    if tess.batches > 1:
-        tess.stats["batches"] = tess.batches
+    result = tessellate_to_file(tessellator, scene, output, max_memory_bytes=args.max_memory, eps=args.eps,
+                                pixels=args.pixels, max_factor=args.max_factor,
+                                forward_differencing=not args.no_fd, **mesh_options)
+    if result.batches > 1:
+        result.stats["batches"] = result.batches
 
-    saturated = int(tess.stats.get("saturated", 0))
+    saturated = int(result.stats.get("saturated", 0))
     if saturated:
         patches = "1 patch reaches" if saturated == 1 else f"{saturated} patches reach"
         verb = "does" if saturated == 1 else "do"
         print(f"{PROG}: warning: {patches} --max-factor {args.max_factor} and {verb} not meet the error "
               "bound; raise --max-factor", file=sys.stderr)
-    sharp = int(tess.stats.get("sharp_edges", 0))
+    sharp = int(result.stats.get("sharp_edges", 0))
     if sharp and args.sharp_edges == "keep":
         print(f"{PROG}: warning: {sharp} sharp mesh edge{'s' if sharp > 1 else ''} keep each side's own PN "
               "curve, so the mesh may crack there; --sharp-edges straight or average keeps it closed",
               file=sys.stderr)
     if not args.quiet:
         tolerance = f"eps {args.eps:g}" if args.eps is not None else f"{args.pixels:g} px"
-        print(format_summary(tess.stats, tess.stage_ms, scene=args.scene, device=device.name.strip(),
+        print(format_summary(result.stats, result.stage_ms, scene=args.scene, device=device.name.strip(),
                              tolerance=tolerance, output=output))
     return EXIT_OK
 
