@@ -397,6 +397,8 @@ def boundary_point(curve: np.ndarray, k: int, f: int) -> np.ndarray:
     The kernel evaluates from the nearer end so both patches sharing the curve, walking it in
     opposite directions, do the same arithmetic (Mesa's tessellator places points likewise).
     """
+    if k == 0:  # the corner, exactly (the kernel returns the control point itself)
+        return curve[0, :3] / curve[0, 3]
     b = curve if 2 * k <= f else curve[::-1]
     t = min(k, f - k) / f
     c = bernstein3(np.array(t)) @ b

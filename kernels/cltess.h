@@ -188,9 +188,13 @@ inline float4 lerp4(float4 a, float4 b, float t) { return a + t * (b - a); }
 /* Point k of f on a boundary curve, placed symmetrically about the midpoint: de Casteljau
  * from the nearer end, and at the midpoint the commutative (a + b) / 2.  A neighbour walking
  * the shared curve the other way gets bitwise the same point (Mesa's tessellator does the
- * same for D3D11 patterns).  t = 0 returns the end control point exactly. */
+ * same for D3D11 patterns).  k = 0 returns the end control point exactly. */
 inline float4 boundary_point(const float4 c[4], int k, int f)
 {
+    /* The corner itself, bit for bit: c0 + 0 * (c1 - c0) turns a -0.0 of c0 into +0.0 or not
+     * depending on c1, which differs between the patches meeting there. */
+    if (k == 0)
+        return c[0];
     float4 q[4];
     int forward = 2 * k < f;
     for (int i = 0; i < 4; ++i)
