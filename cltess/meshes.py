@@ -37,6 +37,8 @@ def read_mesh(path, object_id: int = 0) -> TriangleMesh:
         raise SceneError(f"{name}: file not found")
     if file.is_dir():
         raise SceneError(f"{name}: is a directory, not a mesh file")
+    if file.suffix.lower() == ".stl":
+        _check_binary_stl(file, name)
     # trimesh logs, and without scipy prints tracebacks for, fallbacks it takes: keep it quiet.
     quiet = logging.getLogger("trimesh")
     level, quiet.level = quiet.level, logging.CRITICAL
@@ -54,6 +56,21 @@ def read_mesh(path, object_id: int = 0) -> TriangleMesh:
     else:
         raise SceneError(f"{name}: the mesh has no faces (read as a {type(loaded).__name__})")
     return TriangleMesh(vertices, faces, normals, object_id, name)
+
+
+def _check_binary_stl(file: Path, name: str) -> None:
+    """A binary STL is an 80-byte header, a triangle count, 50 bytes per triangle.  When the
+    count does not fit the size and the file is not ASCII ("solid ..."), say so here: trimesh
+    would fall back to its ASCII reader and fail with an unrelated message."""
+    size = file.stat().st_size
+    with file.open("rb") as handle:
+        head = handle.read(84)
+    if head.lstrip().lower().startswith(b"solid") or len(head) < 84:
+        return  # ASCII (or too short for binary): trimesh reports what is wrong
+    count = int.from_bytes(head[80:84], "little")
+    if 84 + 50 * count != size:
+        raise SceneError(f"{name}: binary STL header says {count} triangles ({84 + 50 * count} bytes), "
+                         f"but the file has {size} bytes: truncated or not an STL file")
 
 
 def _has_normals(mesh) -> bool:

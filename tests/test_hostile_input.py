@@ -400,3 +400,13 @@ def test_json_instancing_beyond_memory_is_refused_before_copying(tmp_path, monke
     err = capsys.readouterr().err
     assert code == 2 and "herd.json" in err and "objects[" in err and "memory" in err
     assert not (tmp_path / "out.ply").exists()
+
+
+def test_a_binary_stl_whose_count_does_not_fit_its_size_says_so(capsys, tmp_path):
+    """Not trimesh's ASCII fallback error (an unrelated missing module): the count and the size."""
+    stl = tmp_path / "cut.stl"
+    stl.write_bytes(bytes(80) + (3).to_bytes(4, "little") + bytes(100))  # 3 triangles need 234 bytes
+    code = main(["tessellate", str(stl), "--eps", "0.1", "-o", str(tmp_path / "out.ply")])
+    err = capsys.readouterr().err
+    assert code == 2 and "cut.stl" in err and "3 triangles" in err and "184 bytes" in err
+    assert not (tmp_path / "out.ply").exists()
