@@ -31,6 +31,23 @@ inline float patch_tolerance(float3 lo, float3 hi, float eps, int camera_on, flo
     return pixels * max(nearest, near) * pixel_size;
 }
 
+/* The factor for a step of 1/inverse: ceil, at least 1; above max_factor it is clamped and
+ * *saturated set (the bound is not met there). */
+inline int edge_factor(float inverse, int max_factor, int *saturated)
+{
+    if (inverse <= (float)max_factor)
+        return max((int)ceil(inverse), 1);
+    *saturated = 1;
+    return max_factor;
+}
+
+/* A patch with no output (culled, or a folded triangle): factors 0 and why, in flags. */
+inline void no_output(__global int4 *factors, __global int *flags, uint i, int why)
+{
+    factors[i] = (int4)(0);
+    flags[i] = why;
+}
+
 /* factors[p] = (m, n, m, n) by edge; flags[p]: bit 0 saturated (the bound is not met at
  * max_factor), bit 1 culled (factors 0). */
 __kernel void zs_factors(__global const float4 *patches, uint num_patches, uint patch_base, float eps,
@@ -55,8 +72,7 @@ __kernel void zs_factors(__global const float4 *patches, uint num_patches, uint 
     int culled;
     float tol = patch_tolerance(lo, hi, eps, camera_on, view, frustum, pixels, pixel_size, &culled);
     if (culled) {
-        factors[patch_base + p] = (int4)(0);
-        flags[patch_base + p] = 2;
+        no_output(factors, flags, patch_base + p, 2);
         return;
     }
 
@@ -99,9 +115,9 @@ __kernel void zs_factors(__global const float4 *patches, uint num_patches, uint 
     float d_uv = 9.0f * uv.x + r * 9.0f * uv.y + w_u * slope_v + w_v * slope_u;
     float2 step = zs_steps(d_uu, d_uv, d_vv, 8.0f * tol * min_w);
     float2 inverse = 1.0f / step;
-    int saturated = !(inverse.x <= (float)max_factor && inverse.y <= (float)max_factor);
-    int m = inverse.x <= (float)max_factor ? max((int)ceil(inverse.x), 1) : max_factor;
-    int n = inverse.y <= (float)max_factor ? max((int)ceil(inverse.y), 1) : max_factor;
+    int saturated = 0;
+    int m = edge_factor(inverse.x, max_factor, &saturated);
+    int n = edge_factor(inverse.y, max_factor, &saturated);
     factors[patch_base + p] = (int4)(m, n, m, n);
     flags[patch_base + p] = saturated;
 }
@@ -131,8 +147,7 @@ __kernel void pn_factors(__global const float4 *triangles, __global float4 *cont
     float3 p0 = in[0].xyz, p1 = in[1].xyz, p2 = in[2].xyz;
     if ((p0.x == p1.x && p0.y == p1.y && p0.z == p1.z) || (p1.x == p2.x && p1.y == p2.y && p1.z == p2.z)
         || (p2.x == p0.x && p2.y == p0.y && p2.z == p0.z)) {
-        factors[patch_base + p] = (int4)(0);
-        flags[patch_base + p] = 4;
+        no_output(factors, flags, patch_base + p, 4);
         return;
     }
     float3 lo = b[0].xyz, hi = lo;  /* the patch lies in its control points' hull */
@@ -143,8 +158,7 @@ __kernel void pn_factors(__global const float4 *triangles, __global float4 *cont
     int culled;
     float tol = patch_tolerance(lo, hi, eps, camera_on, view, frustum, pixels, pixel_size, &culled);
     if (culled) {
-        factors[patch_base + p] = (int4)(0);
-        flags[patch_base + p] = 2;
+        no_output(factors, flags, patch_base + p, 2);
         return;
     }
     float d[9];
@@ -153,8 +167,7 @@ __kernel void pn_factors(__global const float4 *triangles, __global float4 *cont
     for (int e = 0; e < 3; ++e) {
         float curvature = d[4 * e] + max(d[3 * e + (e + 1) % 3], d[3 * e + (e + 2) % 3]);
         float inverse = sqrt(curvature / (4.0f * tol));  /* 1 / delta_e */
-        saturated |= !(inverse <= (float)max_factor);
-        f[e] = inverse <= (float)max_factor ? max((int)ceil(inverse), 1) : max_factor;
+        f[e] = edge_factor(inverse, max_factor, &saturated);
     }
     factors[patch_base + p] = (int4)(f[0], f[1], f[2], 0);
     flags[patch_base + p] = saturated;
