@@ -4,9 +4,14 @@
 >>> tess = Tessellator().tessellate(load_scene("scenes/teapot.bez"), eps=1e-3)
 >>> export(tess, "teapot.ply")
 """
-from .export import export
-from .scene import Camera, Scene, SceneError
-from .tessellation import Tessellation
+from .runtimes import register_pip_runtimes
+
+# Before anything lists OpenCL platforms: let the ICD loader see pip-installed CPU runtimes.
+register_pip_runtimes()
+
+from .export import export  # noqa: E402
+from .scene import Camera, Scene, SceneError  # noqa: E402
+from .tessellation import Tessellation  # noqa: E402
 
 
 def __getattr__(name):

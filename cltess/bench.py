@@ -46,7 +46,7 @@ from .scene import Camera, Scene
 
 REPO = Path(__file__).resolve().parent.parent
 SCENES_DIR = REPO / "scenes"
-DATA_ENV_VAR = "CLTESS_DATA"  # folder holding bigguy.bez (default ../shared/data)
+DATA_ENV_VAR = "CLTESS_DATA"  # folder holding bigguy.bez (default scenes/)
 
 PIXELS = 0.5
 WIDTH, HEIGHT, FOV_Y = 1024, 768, 45.0
@@ -140,13 +140,10 @@ def _bounds(scene: Scene):
 
 
 def data_dir() -> Path:
-    """Where bigguy.bez lives: ``$CLTESS_DATA``, else ``../shared/data`` or ``shared/data``."""
+    """Where bigguy.bez lives: ``$CLTESS_DATA``, else the repository's ``scenes/``."""
     if os.environ.get(DATA_ENV_VAR):
         return Path(os.environ[DATA_ENV_VAR])
-    for candidate in (REPO.parent / "shared" / "data", REPO / "shared" / "data"):
-        if (candidate / "bigguy.bez").exists():
-            return candidate
-    return REPO.parent / "shared" / "data"
+    return SCENES_DIR
 
 
 def tea_table() -> Scene:

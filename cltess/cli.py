@@ -1,6 +1,6 @@
 """The ``cltess`` command line.
 
-    cltess devices
+    cltess devices [--verbose]
     cltess tessellate SCENE (--eps E | --pixels PX) [--no-fd] [--max-factor N] [--max-memory SIZE]
                       [--sharp-edges {straight,average,keep}] [--device NAME] [--quiet] -o OUT
     cltess bench [SCENES...] [--device NAME] [--repeat N] [--warmup N] [--no-baseline] [--json OUT]
@@ -15,6 +15,7 @@ import argparse
 import math
 import os
 import sys
+import warnings
 from pathlib import Path
 
 from cltess.export import SUPPORTED_EXTENSIONS, check_extension
@@ -87,15 +88,21 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    # Every command takes --verbose: full OpenCL build logs and compiler output.
+    verbose = _Parser(add_help=False)
+    verbose.add_argument("-v", "--verbose", action="store_true",
+                         help="show full OpenCL build logs and compiler warnings")
 
     commands.add_parser(
-        "devices", help="list OpenCL platforms and devices",
-        description="List OpenCL platforms and devices; '*' marks the default "
-                    "($CLTESS_DEVICE, else the first CPU device).",
+        "devices", help="list OpenCL platforms and devices, and whether each is usable",
+        parents=[verbose],
+        description="List OpenCL platforms and devices, each probed with a small kernel: usable, "
+                    "fails to build or fails to run, with the reason. '*' marks the default "
+                    "($CLTESS_DEVICE, else the first usable CPU device, else the first usable device).",
     )
 
     run = commands.add_parser(
-        "tessellate", help="tessellate a scene and export the mesh",
+        "tessellate", help="tessellate a scene and export the mesh", parents=[verbose],
         description="Tessellate a scene (.bpt, .bez or .json, or a triangle mesh as PN triangles: "
                     ".obj, .ply, .stl, .off, .glb, .gltf) and write the mesh "
                     f"({', '.join(SUPPORTED_EXTENSIONS)}).",
@@ -112,7 +119,7 @@ def build_parser() -> argparse.ArgumentParser:
                      help=f"largest edge factor per patch (default {DEFAULT_MAX_FACTOR})")
     run.add_argument("--device", metavar="NAME",
                      help="OpenCL device: substring of platform or device name (default $CLTESS_DEVICE, "
-                          "else the first CPU device)")
+                          "else the first usable CPU device; see 'cltess devices')")
     run.add_argument("--max-memory", type=_memory_size, metavar="SIZE",
                      help="cap on the memory the output may take at once (e.g. 512M, 2G); a larger "
                           "output is tessellated in batches streamed to the file (.ply, .obj). "
@@ -127,6 +134,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     bench = commands.add_parser(
         "bench", help="benchmark suite: the CudaTess paper's Tables 1 and 2 on one device",
+        parents=[verbose],
         description="Generate the benchmark scenes (0.5 px, 1024x768, a camera each), time every "
                     "stage on one OpenCL device and print the paper-style tables (cltess.bench).",
     )
@@ -146,8 +154,9 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def cmd_devices(args) -> int:
-    """One line per platform, one per device under it; '*' marks the default device."""
-    from cltess.device import DEVICE_ENV_VAR, DeviceError, default_device_info, list_devices
+    """One line per platform, one per device under it with its probe verdict; '*' marks the
+    default device."""
+    from cltess.device import DEVICE_ENV_VAR, DeviceError, default_device_info, list_devices, probe_device
 
     devices = list_devices()
     try:
@@ -155,8 +164,12 @@ def cmd_devices(args) -> int:
     except DeviceError:
         if not devices:
             raise  # no platform: the install hint
-        print(f"{PROG}: warning: ${DEVICE_ENV_VAR}={os.environ.get(DEVICE_ENV_VAR)!r} matches no device "
-              "below, so there is no default", file=sys.stderr)
+        if os.environ.get(DEVICE_ENV_VAR):
+            print(f"{PROG}: warning: ${DEVICE_ENV_VAR}={os.environ.get(DEVICE_ENV_VAR)!r} names no usable "
+                  "device below, so there is no default", file=sys.stderr)
+        else:
+            print(f"{PROG}: warning: no device below is usable, so there is no default; see the "
+                  "README's Troubleshooting", file=sys.stderr)
         default = None
     platform = None
     for info in devices:
@@ -165,8 +178,11 @@ def cmd_devices(args) -> int:
             print(f"{info.platform} ({info.platform_vendor}; {info.platform_version})")
         marker = "*" if default is not None and info.device == default.device else " "
         memory_gib = info.global_memory_bytes / 2**30
+        probe = probe_device(info)
         print(f"  {marker} {info.name}  [{info.type}]  {info.version}  "
-              f"{info.compute_units} compute units  {memory_gib:.1f} GiB")
+              f"{info.compute_units} compute units  {memory_gib:.1f} GiB  {probe.describe()}")
+        if args.verbose and probe.log:
+            print("      " + probe.log.strip().replace("\n", "\n      "))
     return EXIT_OK
 
 
@@ -276,15 +292,22 @@ def main(argv: list[str] | None = None) -> int:
     from cltess.device import DeviceError
     from cltess.scene import SceneError
 
+    args = None
     try:
         args = build_parser().parse_args(argv)
+        if not args.verbose:  # pyopencl's "non-empty compiler output" means nothing to a user
+            warnings.filterwarnings("ignore", category=cl.CompilerWarning)
         return _COMMANDS[args.command](args)
     except SystemExit as done:  # --help / --version
         return done.code if isinstance(done.code, int) else EXIT_OK
     except KeyboardInterrupt:
         print(f"{PROG}: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
-    except (DeviceError, cl.Error, MemoryError) as error:
+    except DeviceError as error:
+        if error.log and args is not None and args.verbose:
+            print(error.log, file=sys.stderr)
+        return _fail(error, EXIT_DEVICE)
+    except (cl.Error, MemoryError) as error:
         return _fail(error, EXIT_DEVICE)
     except UsageError as error:
         if error.usage:

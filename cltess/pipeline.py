@@ -32,7 +32,7 @@ from pyopencl.scan import GenericScanKernel
 from . import reference
 from .adjacency import (SHARP_EDGE_MODES, EdgeGroups, edge_groups, merge_edge_groups, mesh_edge_groups,
                         pn_edge_normals)
-from .device import pick_device
+from .device import BuildError, first_error_line, pick_device
 from .reference import DEFAULT_MAX_FACTOR
 from .scene import Scene
 from .tessellation import Tessellation
@@ -199,7 +199,8 @@ class Programs:
             try:
                 self.built[stage] = cl.Program(context, source).build(options=options)
             except cl.RuntimeError as error:  # the build log is in the message
-                raise RuntimeError(f"kernels/{stage}.cl failed to build:\n{error}") from error
+                raise BuildError(f"kernels/{stage}.cl failed to build on {context.devices[0].name.strip()!r}: "
+                                 f"{first_error_line(error)}. The full log: --verbose", log=str(error)) from error
         self.crack_free_factors = self.built["crack_free"].crack_free_factors
         self._kernels = {}
         self.offsets_scan = GenericScanKernel(

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from cltess.adjacency import EdgeGroups, edge_groups
 from cltess.formats import load_scene
 from cltess.scene import boundary_curves
-from support import DATA, SCENES, load_make_scenes
+from support import SCENES, load_make_scenes
 
 make_scenes = load_make_scenes()
 
@@ -78,13 +78,12 @@ def test_teapot_open_edges():
     assert edges == sorted(body_rim + handle_ends + spout_ends + lid_top + lid_rim + bottom_centre)
 
 
-@pytest.mark.skipif(not (DATA / "bigguy.bez").exists(), reason="bigguy.bez not in the shared data folder")
 def test_bigguy_by_position():
     """bigguy's patches share no vertex indices: adjacency comes from equal positions.
     It holds 344 exact duplicate patches (the non-manifold groups and same-direction pairs);
     without them it is consistently oriented, but many neighbours differ by ~1e-7..1e-6
     (12-digit rounding) or meet at T-junctions, so they stay 'boundary' under exact matching."""
-    patches = load_scene(DATA / "bigguy.bez").patches
+    patches = load_scene(SCENES / "bigguy.bez").patches
     assert len(patches) == 3570
     groups = edge_groups(patches)
     check_invariants(groups, patches)

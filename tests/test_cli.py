@@ -21,6 +21,7 @@ from cltess.cli import main
 from cltess.device import DEVICE_ENV_VAR
 from cltess.scene import Scene
 from cltess.tessellation import Tessellation
+from device_faults import UNKNOWN_CPU_LOG, UNKNOWN_CPU_REASON, fresh_probes, pocl_fails_to_build
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -146,6 +147,36 @@ def test_devices_with_unmatched_env_var_still_lists(capsys, monkeypatch):
     assert code == 0
     assert "Portable Computing Language" in out and "*" not in out
     assert "warning" in err and "no-such-device" in err
+
+
+def test_devices_shows_each_verdict_and_never_stars_a_failing_device(capsys, monkeypatch, tmp_path):
+    fresh_probes(monkeypatch, tmp_path)
+    pocl_fails_to_build(monkeypatch)
+    code, out, err = run(capsys, "devices")
+    assert code == 0
+    pocl_line = next(line for line in out.splitlines() if "pthread" in line)
+    assert pocl_line.endswith(f"fails to build: {UNKNOWN_CPU_REASON}")
+    assert not pocl_line.lstrip().startswith("*")
+    assert "valid target CPU" not in out  # the full log only with --verbose
+    assert all(line.endswith("usable") for line in out.splitlines()
+               if line.startswith("  ") and "pthread" not in line and not line.startswith("      "))
+    code, out, err = run(capsys, "devices", "--verbose")
+    assert code == 0 and "valid target CPU values" in out
+
+
+def test_named_failing_device_exits_1_with_a_short_error(capsys, monkeypatch, tmp_path, scene_file):
+    fresh_probes(monkeypatch, tmp_path)
+    pocl_fails_to_build(monkeypatch)
+    out_path = tmp_path / "out.ply"
+    code, out, err = run(capsys, "tessellate", scene_file, "--eps", "1e-3", "--device", "pocl", "-o", out_path)
+    assert code == 1 and out == ""
+    assert_clean_error(err, "pthread", UNKNOWN_CPU_REASON, "--verbose")
+    assert len(err.strip().splitlines()) == 1 and "valid target CPU" not in err
+    assert not out_path.exists()
+    code, out, err = run(capsys, "tessellate", scene_file, "--eps", "1e-3", "--device", "pocl", "-o", out_path,
+                         "--verbose")
+    assert code == 1 and UNKNOWN_CPU_LOG in err and "Traceback" not in err
+    assert not out_path.exists()
 
 
 # --------------------------------------------------------------------------- argument validation

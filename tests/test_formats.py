@@ -37,7 +37,7 @@ def test_shipped_files(name, count):
 
 
 def test_shipped_files_are_the_shared_data():
-    for name in ("teapot.bez", "teapot.bpt", "teacup.bez", "teaspoon.bez"):
+    for name in ("teapot.bez", "teapot.bpt", "teacup.bez", "teaspoon.bez", "bigguy.bez"):
         if (DATA / name).exists():
             assert (SCENES / name).read_bytes() == (DATA / name).read_bytes()
 
@@ -52,10 +52,9 @@ def test_teapot_bpt_equals_bez():
     assert bpt[0, 1, 0].tolist() == [1.3375, 0.0, 2.53125, 1.0]
 
 
-@pytest.mark.skipif(not (DATA / "bigguy.bez").exists(), reason="bigguy.bez not in the shared data folder")
 def test_bigguy_loads_fast():
     start = time.perf_counter()
-    scene = load_scene(DATA / "bigguy.bez")
+    scene = load_scene(SCENES / "bigguy.bez")
     elapsed = time.perf_counter() - start
     assert scene.num_patches == 3570
     assert elapsed < 2.0, f"bigguy.bez took {elapsed:.2f} s"  # ~0.1 s here

@@ -321,6 +321,7 @@ def test_no_opencl_platform_end_to_end(tmp_path):
     output.write_bytes(EXISTING)
     env = {k: v for k, v in os.environ.items() if k not in (DEVICE_ENV_VAR, "PYOPENCL_CTX")}
     env["OCL_ICD_VENDORS"] = str(vendors)
+    env["CLTESS_REGISTER_RUNTIMES"] = "0"  # nor Intel's pip-installed runtime
     child = ("import os, sys, pyopencl\n"
              "os.environ['PYOPENCL_HOME'] = os.environ['OCL_ICD_VENDORS']\n"
              "from cltess.cli import main\n"
