@@ -23,7 +23,7 @@ def pocl_fails_to_build(monkeypatch) -> None:
     real_build = device_module._build_probe
 
     def build(context):
-        if "pthread" in context.devices[0].name:
+        if "Portable Computing Language" in context.devices[0].platform.name:
             raise RuntimeError(UNKNOWN_CPU_LOG)
         return real_build(context)
 
