@@ -62,6 +62,15 @@ def _factor(text: str) -> int:
     return value
 
 
+def _max_factor(text: str) -> int:
+    from cltess.limits import check_max_factor
+
+    try:
+        return check_max_factor(_factor(text))
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error).removeprefix("max_factor ")) from None
+
+
 def _memory_size(text: str) -> int:
     from cltess.stream import parse_size
 
@@ -108,7 +117,7 @@ def build_parser() -> argparse.ArgumentParser:
                            help="screen-space tolerance in pixels (needs a camera in the scene)")
     run.add_argument("--no-fd", action="store_true",
                      help="evaluate every vertex directly instead of by forward differencing")
-    run.add_argument("--max-factor", type=_factor, default=DEFAULT_MAX_FACTOR, metavar="N",
+    run.add_argument("--max-factor", type=_max_factor, default=DEFAULT_MAX_FACTOR, metavar="N",
                      help=f"largest edge factor per patch (default {DEFAULT_MAX_FACTOR})")
     run.add_argument("--device", metavar="NAME",
                      help="OpenCL device: substring of platform or device name (default $CLTESS_DEVICE, "

@@ -33,6 +33,7 @@ from . import reference
 from .adjacency import (SHARP_EDGE_MODES, EdgeGroups, edge_groups, merge_edge_groups, mesh_edge_groups,
                         pn_edge_normals)
 from .device import pick_device
+from .limits import check_max_factor
 from .reference import DEFAULT_MAX_FACTOR
 from .scene import Scene
 from .tessellation import Tessellation
@@ -538,8 +539,7 @@ def _check_tolerance(scene: Scene, eps, pixels, max_factor) -> None:
         raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
     if pixels is not None and scene.camera is None:
         raise ValueError(f"{scene.name}: a pixel tolerance needs a camera in the scene")
-    if int(max_factor) < 1:
-        raise ValueError(f"max_factor must be >= 1, got {max_factor}")
+    check_max_factor(max_factor)
     if scene.num_patches == 0:
         raise ValueError(f"{scene.name}: the scene has no patches")
 

@@ -1,0 +1,92 @@
+"""What the engine can represent, checked up front in one place (issue 9, items 1 and 4).
+
+Edge factors.  The pattern routines of kernels/cltess.h count and number a patch's vertices
+and triangles in 32-bit integers.  With every factor in 1..M, the largest value each of their
+integer expressions takes is (M = max_factor; core factors are at most M):
+
+==============================================  ==========================  ======
+expression (kernels/cltess.h)                   worst case                  type
+==============================================  ==========================  ======
+quad_vertex_count: f0+f1+f2+f3 + (a-1)(b-1)     4M + (M-1)^2 = (M+1)^2      int
+quad_triangles Bresenham: (2o+1) * along        (2M-1) M                    int
+tri_vertex_count: (n-1)(n-2), before / 2        M^2                         int
+tri_triangles Bresenham: 2 (k+1) fe             2 M^2                       int
+put_triangle slot: 3 count + 2                  3 (2M^2 - 1) + 2            uint
+==============================================  ==========================  ======
+
+(a quad patch has at most 2 M^2 triangles, a triangle patch at most M^2).  ``MAX_FACTOR`` is
+the largest M for which all of them fit; a larger ``max_factor`` is refused by
+:func:`check_max_factor`, which both the command line and ``Tessellator`` call.  Global vertex
+numbers are uint32 too (the triangles' indices), so a plan's total must stay below 2^32
+(:func:`check_totals`); the scan itself runs in uint64.
+
+Floats.  The device computes in float32: input that is finite in float64 but not once rounded
+to float32 (or whose products overflow there) would come out as NaN or infinity.
+:data:`FLOAT32_SAFE` is the largest magnitude the readers accept for a coordinate or weight,
+and :data:`FLOAT32_TINY` the smallest positive weight; see ``Scene.check_float32``.
+"""
+from __future__ import annotations
+
+import numbers
+
+import numpy as np
+
+INT32_MAX = 2**31 - 1
+UINT32_MAX = 2**32 - 1
+
+
+def kernel_integer_extremes(m: int) -> dict[str, tuple[int, int]]:
+    """Worst case, over all factors in 1..m, of each integer expression of the pattern
+    routines (table above): name -> (worst value, largest value of its type)."""
+    return {
+        "quad vertex count (int)": ((m + 1) ** 2, INT32_MAX),
+        "quad stitch test (int)": ((2 * m - 1) * m, INT32_MAX),
+        "triangle vertex count (int)": (m * m, INT32_MAX),
+        "triangle stitch test (int)": (2 * m * m, INT32_MAX),
+        "index slot of the last triangle (uint)": (3 * (2 * m * m - 1) + 2, UINT32_MAX),
+    }
+
+
+def _fits(m: int) -> bool:
+    return all(value <= limit for value, limit in kernel_integer_extremes(m).values())
+
+
+def _largest_fitting_factor() -> int:
+    low, high = 1, 2**16  # _fits(low), not _fits(high)
+    while high - low > 1:
+        middle = (low + high) // 2
+        low, high = (middle, high) if _fits(middle) else (low, middle)
+    return low
+
+
+#: The largest max_factor whose per-patch counts the kernels' 32-bit integers hold (26754).
+MAX_FACTOR = _largest_fitting_factor()
+
+#: Largest |coordinate| or weight accepted: float32's largest finite value with room for the
+#: device's sums and differences of a few control points (a factor 2**20 below 3.4e38).
+FLOAT32_SAFE = float(np.finfo(np.float32).max) / 2**20
+#: Smallest weight accepted: float32's smallest normal number; below it a weight is rounded to
+#: a subnormal or zero and the division by it overflows.
+FLOAT32_TINY = float(np.finfo(np.float32).tiny)
+
+
+def check_max_factor(value) -> int:
+    """``value`` as an int in 1..MAX_FACTOR, else ValueError saying why."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise ValueError(f"max_factor must be an integer, got {value!r}")
+    value = int(value)
+    if not 1 <= value <= MAX_FACTOR:
+        raise ValueError(f"max_factor must be in 1..{MAX_FACTOR} (the largest factor whose per-patch "
+                         f"vertex and index counts fit the kernels' 32-bit integers), got {value}")
+    return value
+
+
+def check_totals(name: str, num_vertices: int, num_indices: int) -> None:
+    """A plan's totals: its vertices must be numbered by uint32 triangle indices."""
+    if num_vertices > UINT32_MAX:
+        raise ValueError(f"{name}: the output would have {num_vertices} vertices, more than the "
+                         f"{UINT32_MAX} that 32-bit triangle indices can number; raise the tolerance "
+                         "or lower max_factor")
+    if num_indices // 3 > UINT32_MAX:
+        raise ValueError(f"{name}: the output would have {num_indices // 3} triangles, more than "
+                         f"{UINT32_MAX}; raise the tolerance or lower max_factor")

@@ -1,0 +1,203 @@
+"""Issue 9, host side: no tracebacks on any input (item 5), no non-finite output (item 4), no
+size the kernels cannot hold (item 1), bounded and named file handling (item 7), signals
+(item 6).  Each refusal is checked on the command line where the user meets it: exit code,
+``cltess: error: <file>: <where>: ...``, no output file and no temporary file left behind.
+"""
+from __future__ import annotations
+
+import itertools
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import strategies as st
+
+from cltess import limits, reference
+from cltess.cli import build_parser, main, UsageError
+from cltess.device import DEVICE_ENV_VAR
+from cltess.formats import load_scene
+from cltess.scene import Scene, SceneError
+
+REPO = Path(__file__).resolve().parents[1]
+TEAPOT = REPO / "scenes" / "teapot.bez"
+FUZZ = settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+
+
+@pytest.fixture(autouse=True)
+def no_device_env(monkeypatch):
+    monkeypatch.delenv(DEVICE_ENV_VAR, raising=False)
+
+
+def bpt_lines(weights: bool = False) -> list[str]:
+    points = [f"{i / 3} {j / 3} {0.1 * (i - 1.5) ** 2}" + (" 1.5" if weights else "")
+              for j in range(4) for i in range(4)]
+    return ["1", "3 3", *points]
+
+
+def bez_lines() -> list[str]:
+    return ["1", ",".join(map(str, range(1, 17))), "16",
+            *(f"{i},{j},{(i * j) % 3 * 0.1}" for j in range(4) for i in range(4))]
+
+
+def run_cli(capsys, *argv) -> tuple[int, str]:
+    code = main([str(a) for a in argv])
+    return code, capsys.readouterr().err
+
+
+def assert_refused(code: int, err: str, fragments, expected_code: int = 2) -> None:
+    assert code == expected_code, err
+    assert "Traceback" not in err, err
+    assert err.count("cltess: error: ") == 1, err
+    for fragment in fragments:
+        assert fragment in err, f"{fragment!r} not in {err!r}"
+
+
+def assert_nothing_written(folder: Path) -> None:
+    assert [p.name for p in folder.iterdir()] == [], "an output or temporary file was left behind"
+
+
+def load_or_scene_error(path: Path):
+    """load_scene's only way to fail is a SceneError naming the file."""
+    try:
+        return load_scene(path)
+    except SceneError as error:
+        assert str(error).startswith(str(path)), error
+        return None
+
+
+# --------------------------------------------------------------------------- item 5: tracebacks
+
+#: Tokens worth putting where a number goes: Unicode digits and spaces, numpy-only spellings.
+ODD_TOKENS = st.sampled_from(["\uff11", "\u0661.5", "1\u00a02", "1_0", "0x10", "1e", "nan", "-inf",
+                              "\u2003", "1e400", "1e-400", "+", ".", "\x0c", "\x1c", "\u2028", "١٢٣",
+                              "9" * 400, "1" * 5000, "0.5\u200b", "²", "½", "1d0", "--1", "1e+"])
+
+
+@FUZZ
+@given(line=st.integers(0, 17), column=st.integers(0, 3),
+       token=st.one_of(ODD_TOKENS, st.text(max_size=12)), weights=st.booleans())
+def test_bpt_with_any_token_loads_or_is_refused_by_name(tmp_path_factory, line, column, token, weights):
+    lines = bpt_lines(weights)
+    fields = lines[line].split()
+    fields[min(column, len(fields) - 1)] = token
+    lines[line] = " ".join(fields)
+    path = tmp_path_factory.mktemp("bpt") / "s.bpt"
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8", errors="surrogatepass") \
+        if not any(0xD800 <= ord(c) <= 0xDFFF for c in token) else path.write_bytes(b"\xed\xa0\x80")
+    load_or_scene_error(path)
+
+
+@FUZZ
+@given(line=st.integers(0, 18), column=st.integers(0, 15), token=st.one_of(ODD_TOKENS, st.text(max_size=12)))
+def test_bez_with_any_token_loads_or_is_refused_by_name(tmp_path_factory, line, column, token):
+    assume(not any(0xD800 <= ord(c) <= 0xDFFF for c in token))
+    lines = bez_lines()
+    fields = lines[line].split(",")
+    fields[min(column, len(fields) - 1)] = token
+    lines[line] = ",".join(fields)
+    path = tmp_path_factory.mktemp("bez") / "s.bez"
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    load_or_scene_error(path)
+
+
+@FUZZ
+@given(data=st.binary(max_size=400), suffix=st.sampled_from([".bpt", ".bez", ".json"]))
+def test_any_bytes_load_or_are_refused_by_name(tmp_path_factory, data, suffix):
+    path = tmp_path_factory.mktemp("bytes") / f"s{suffix}"
+    path.write_bytes(data)
+    load_or_scene_error(path)
+
+
+JSON_VALUES = st.recursive(
+    st.none() | st.booleans() | st.integers(-(10**400), 10**400) | st.floats(allow_nan=False) | st.text(max_size=8),
+    lambda children: st.lists(children, max_size=5) | st.dictionaries(st.text(max_size=8), children, max_size=4),
+    max_leaves=12)
+
+
+def _json_slots(doc):
+    """Every (container, key) of a JSON document."""
+    if isinstance(doc, dict):
+        for key, value in doc.items():
+            yield doc, key
+            yield from _json_slots(value)
+    elif isinstance(doc, list):
+        for k, value in enumerate(doc):
+            yield doc, k
+            yield from _json_slots(value)
+
+
+@FUZZ
+@given(slot=st.integers(0, 200), value=JSON_VALUES)
+def test_json_with_any_value_loads_or_is_refused_by_name(tmp_path_factory, slot, value):
+    folder = tmp_path_factory.mktemp("json")
+    (folder / "p.bpt").write_text("\n".join(bpt_lines()) + "\n")
+    doc = {"objects": [{"file": "p.bpt", "object_id": 3,
+                        "transform": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]}],
+           "camera": {"eye": [0, -5, 1], "target": [0, 0, 0], "up": [0, 0, 1], "fov_y_deg": 40,
+                      "width": 64, "height": 48, "near": 0.1, "far": 100}}
+    slots = list(_json_slots(doc))
+    container, key = slots[slot % len(slots)]
+    container[key] = value
+    path = folder / "s.json"
+    path.write_text(json.dumps(doc))
+    load_or_scene_error(path)
+
+
+def test_full_width_digit_in_bpt_names_file_and_line(capsys, tmp_path):
+    lines = bpt_lines()
+    lines[5] = "\uff10.5 0.5 0"
+    scene = tmp_path / "s.bpt"
+    scene.write_text("\n".join(lines) + "\n")
+    out = tmp_path / "out"
+    out.mkdir()
+    code, err = run_cli(capsys, "tessellate", scene, "--eps", "0.01", "-o", out / "m.ply")
+    assert_refused(code, err, [f"{scene}: line 6", "not a number", "\uff10.5"])
+    assert_nothing_written(out)
+
+
+def test_json_integer_too_large_for_a_float_is_refused_by_key(capsys, tmp_path):
+    scene = tmp_path / "s.json"
+    scene.write_text(json.dumps({"objects": [{"file": str(TEAPOT)}],
+                                 "camera": {"eye": [0, 0, 10**400], "target": [0, 0, 0]}}))
+    out = tmp_path / "out"
+    out.mkdir()
+    code, err = run_cli(capsys, "tessellate", scene, "--eps", "0.01", "-o", out / "m.ply")
+    assert_refused(code, err, [f"{scene}: camera.eye", "finite"])
+    assert_nothing_written(out)
+
+
+@pytest.mark.parametrize("value", ["2147483648", "65536", str(limits.MAX_FACTOR + 1), "9" * 30])
+def test_max_factor_beyond_the_kernels_integers_exits_2(capsys, tmp_path, value):
+    scene = tmp_path / "s.bpt"
+    scene.write_text("\n".join(bpt_lines()) + "\n")
+    out = tmp_path / "out"
+    out.mkdir()
+    code, err = run_cli(capsys, "tessellate", scene, "--eps", "0.01", "--max-factor", value, "-o", out / "m.ply")
+    assert_refused(code, err, ["--max-factor", f"1..{limits.MAX_FACTOR}", "32-bit"])
+    assert_nothing_written(out)
+
+
+@settings(max_examples=300, deadline=None)
+@given(eps=st.text(max_size=12), max_factor=st.text(max_size=12), memory=st.text(max_size=12))
+def test_any_option_text_parses_or_is_a_usage_error(eps, max_factor, memory):
+    arguments = ["tessellate", "s.bpt", "-o", "m.ply", "--eps", eps, "--max-factor", max_factor,
+                 "--max-memory", memory]
+    assume(not any(a.startswith("-") and a not in ("--eps", "--max-factor", "--max-memory", "-o")
+                   for a in (eps, max_factor, memory)))
+    try:
+        args = build_parser().parse_args(arguments)
+    except UsageError:
+        return
+    assert math.isfinite(args.eps) and args.eps > 0
+    assert 1 <= args.max_factor <= limits.MAX_FACTOR
+    assert 0 < args.max_memory < 2**63
+
+
+@pytest.mark.parametrize("value", [0, limits.MAX_FACTOR + 1, 2**31, 2.5, True])
+def test_api_refuses_a_max_factor_the_kernels_cannot_hold(tessellator, value):
+    scene = load_scene(TEAPOT)
+    with pytest.raises(ValueError, match="max_factor must be"):
+        tessellator.tessellate(scene, eps=0.01, max_factor=value)
