@@ -32,6 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .limits import float32_problem
 from .meshes import MESH_EXTENSIONS, read_mesh, read_mesh_scene
 from .scene import Camera, Scene, SceneError
 
@@ -218,7 +219,12 @@ def _parse_bpt(lines: _Lines) -> np.ndarray:
         r = int(bad[0])
         raise lines.error(point_ks[r], f"patch {r // 16}: weight {float(weights[r])!r} <= 0 (weights must be positive)")
     lines.no_trailing(1 + num * _BPT_LINES_PER_PATCH, "patch")
-    return _homogeneous(values.reshape(num, 4, 4, 4))
+    homogeneous = _homogeneous(values)
+    problem = float32_problem(homogeneous)
+    if problem:
+        r, what = problem
+        raise lines.error(point_ks[r], f"patch {r // 16}: {what}")
+    return homogeneous.reshape(num, 4, 4, 4)
 
 
 # --------------------------------------------------------------------------- .bez
@@ -254,7 +260,12 @@ def _parse_bez(lines: _Lines) -> np.ndarray:
         r = int(np.argmax(values[:, 3] <= 0))
         raise lines.error(first + r, f"vertex {r + 1}: weight {float(values[r, 3])!r} <= 0 (weights must be positive)")
     lines.no_trailing(first + num_vertices, "vertex")
-    return _homogeneous(values)[indices - 1].reshape(num, 4, 4, 4)
+    homogeneous = _homogeneous(values)
+    problem = float32_problem(homogeneous)
+    if problem:
+        r, what = problem
+        raise lines.error(first + r, f"vertex {r + 1}: {what}")
+    return homogeneous[indices - 1].reshape(num, 4, 4, 4)
 
 
 def _indices(lines: _Lines, first: int, rows: list[list[str]], num_vertices: int) -> np.ndarray:
@@ -480,6 +491,10 @@ def _check_transformed(patches: np.ndarray, where: _Where, key: str) -> None:
     if not positive.all():
         p = int(np.argmin(positive))
         raise where.error(key, f"patch {p}: weight {float(patches[p, ..., 3].min())!r} <= 0 after the transform")
+    problem = float32_problem(patches.reshape(-1, 4))
+    if problem:
+        r, what = problem
+        raise where.error(key, f"patch {r // 16}: after the transform, {what}")
 
 
 def _camera(value, where: _Where) -> Camera:

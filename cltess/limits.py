@@ -22,8 +22,8 @@ numbers are uint32 too (the triangles' indices), so a plan's total must stay bel
 
 Floats.  The device computes in float32: input that is finite in float64 but not once rounded
 to float32 (or whose products overflow there) would come out as NaN or infinity.
-:data:`FLOAT32_SAFE` is the largest magnitude the readers accept for a coordinate or weight,
-and :data:`FLOAT32_TINY` the smallest positive weight; see ``Scene.check_float32``.
+:data:`HOMOGENEOUS_MAX` and :data:`WEIGHT_MIN` bound what the readers, ``Scene`` and
+``TriangleMesh`` accept (:func:`float32_problem`).
 """
 from __future__ import annotations
 
@@ -62,12 +62,40 @@ def _largest_fitting_factor() -> int:
 #: The largest max_factor whose per-patch counts the kernels' 32-bit integers hold (26754).
 MAX_FACTOR = _largest_fitting_factor()
 
-#: Largest |coordinate| or weight accepted: float32's largest finite value with room for the
-#: device's sums and differences of a few control points (a factor 2**20 below 3.4e38).
-FLOAT32_SAFE = float(np.finfo(np.float32).max) / 2**20
-#: Smallest weight accepted: float32's smallest normal number; below it a weight is rounded to
-#: a subnormal or zero and the division by it overflows.
-FLOAT32_TINY = float(np.finfo(np.float32).tiny)
+#: Largest |component| of a homogeneous control point (w x, w y, w z, w) or mesh position accepted.
+#: The kernels multiply two of them (tangent cross products, squared lengths) with small
+#: integer coefficients: (2**60)**2 * 2**7 stays below float32's largest, 2**128.
+HOMOGENEOUS_MAX = 2.0**60
+#: Smallest weight accepted: its square, 2**-120, is still a normal float32 (2**-126 and up).
+WEIGHT_MIN = 2.0**-60
+#: eps or pixels must be a normal float32.
+TOLERANCE_RANGE = (float(np.finfo(np.float32).tiny), float(np.finfo(np.float32).max))
+
+
+def float32_problem(points: np.ndarray) -> tuple[int, str] | None:
+    """The first row of ``points`` (N, 4) homogeneous, or (N, 3) positions, that the device's
+    float32 arithmetic cannot take, and why; None if all are fine."""
+    points = np.asarray(points, np.float64).reshape(-1, points.shape[-1])
+    with np.errstate(invalid="ignore"):
+        too_large = ~(np.abs(points) <= HOMOGENEOUS_MAX).all(axis=1)
+        too_light = points[:, 3] < WEIGHT_MIN if points.shape[1] == 4 else np.zeros(len(points), bool)
+    bad = too_large | too_light
+    if not bad.any():
+        return None
+    k = int(np.argmax(bad))
+    if too_light[k]:
+        return k, (f"weight {float(points[k, 3])!r} is below 2**-60 ({WEIGHT_MIN:.3g}): too small for the "
+                   "device's float32 arithmetic")
+    what = "homogeneous point (w x, w y, w z, w)" if points.shape[1] == 4 else "position"
+    return k, (f"{what} {np.array2string(points[k], precision=6)} has a component beyond +-2**60 "
+               f"({HOMOGENEOUS_MAX:.3g}): too large for the device's float32 arithmetic")
+
+
+def check_tolerance_value(name: str, value: float) -> None:
+    """eps or pixels: ValueError unless a normal, finite float32 (it is passed as one)."""
+    low, high = TOLERANCE_RANGE
+    if not low <= value <= high:
+        raise ValueError(f"{name} must be between {low:.3g} and {high:.3g} (a float32), got {value!r}")
 
 
 def check_max_factor(value) -> int:

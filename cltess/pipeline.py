@@ -33,7 +33,7 @@ from . import reference
 from .adjacency import (SHARP_EDGE_MODES, EdgeGroups, edge_groups, merge_edge_groups, mesh_edge_groups,
                         pn_edge_normals)
 from .device import pick_device
-from .limits import check_max_factor
+from .limits import check_max_factor, check_tolerance_value
 from .reference import DEFAULT_MAX_FACTOR
 from .scene import Scene
 from .tessellation import Tessellation
@@ -537,6 +537,7 @@ def _check_tolerance(scene: Scene, eps, pixels, max_factor) -> None:
     name = "eps" if eps is not None else "pixels"
     if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
         raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+    check_tolerance_value(name, value)
     if pixels is not None and scene.camera is None:
         raise ValueError(f"{scene.name}: a pixel tolerance needs a camera in the scene")
     check_max_factor(max_factor)

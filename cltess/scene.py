@@ -32,6 +32,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .limits import float32_problem
+
 
 class SceneError(ValueError):
     """Bad input: the message names the file and the line, patch or field at fault."""
@@ -159,6 +161,9 @@ class TriangleMesh:
         if bad.any():
             v = int(np.argmax(bad))
             raise SceneError(f"{name}: vertex {v}: position {vertices[v].tolist()} is not finite")
+        problem = float32_problem(vertices)
+        if problem:
+            raise SceneError(f"{name}: vertex {problem[0]}: {problem[1]}")
         faces = np.asarray(self.faces)
         if faces.size == 0:
             raise SceneError(f"{name}: the mesh has no faces (PN triangles need triangles)")
@@ -220,6 +225,9 @@ class TriangleMesh:
         bad = ~np.isfinite(out.vertices).all(axis=1)
         if bad.any():
             raise ValueError(f"vertex {int(np.argmax(bad))}: not finite after the transform")
+        problem = float32_problem(out.vertices)
+        if problem:
+            raise ValueError(f"vertex {problem[0]}: after the transform, {problem[1]}")
         if np.linalg.det(matrix[:3, :3]) < 0:  # a mirror: keep the winding with the normals
             out.faces = self.faces[:, ::-1].copy()
         if object_id is not None:
@@ -271,6 +279,12 @@ class Scene:
             raise SceneError(f"{self.name}: patches must have shape (P, 4, 4, 4), got {self.patches.shape}")
         if self.object_ids.shape != (len(self.patches),):
             raise SceneError(f"{self.name}: need one object id per patch")
+        if not np.isfinite(self.patches).all():
+            raise SceneError(f"{self.name}: patch {int(np.argmin(np.isfinite(self.patches).all(axis=(1, 2, 3))))}: "
+                             "control points must be finite")
+        problem = float32_problem(self.patches.reshape(-1, 4))
+        if problem:
+            raise SceneError(f"{self.name}: patch {problem[0] // 16}: {problem[1]}")
         self.meshes = tuple(self.meshes)
         if not all(isinstance(mesh, TriangleMesh) for mesh in self.meshes):
             raise SceneError(f"{self.name}: meshes must be TriangleMesh objects")

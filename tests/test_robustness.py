@@ -201,3 +201,98 @@ def test_api_refuses_a_max_factor_the_kernels_cannot_hold(tessellator, value):
     scene = load_scene(TEAPOT)
     with pytest.raises(ValueError, match="max_factor must be"):
         tessellator.tessellate(scene, eps=0.01, max_factor=value)
+
+
+# --------------------------------------------------------------------------- item 4: non-finite output
+
+
+def tetrahedron_stl(path: Path, flip: tuple[int, int] | None = None) -> Path:
+    """A binary STL tetrahedron; ``flip`` = (triangle, float) sets that float's exponent byte
+    to 0x7e (about 1.7e38: finite in float32, but not once squared or summed)."""
+    import trimesh
+
+    mesh = trimesh.creation.box().subdivide()
+    data = bytearray(trimesh.exchange.stl.export_stl(mesh))
+    if flip is not None:
+        triangle, value = flip
+        at = 84 + 50 * triangle + 12 + 4 * value + 3  # skip the facet normal; the float's top byte
+        data[at] = 0x7E
+    path.write_bytes(bytes(data))
+    return path
+
+
+def json_scene(folder: Path, transform) -> Path:
+    (folder / "p.bpt").write_text("\n".join(bpt_lines()) + "\n")
+    path = folder / "s.json"
+    path.write_text(json.dumps({"objects": [{"file": "p.bpt", "transform": transform}]}))
+    return path
+
+
+def bpt_with_line(folder: Path, line: int, text: str, weights: bool = False) -> Path:
+    lines = bpt_lines(weights)
+    lines[line - 1] = text
+    path = folder / "s.bpt"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+FLOAT32_CASES = [
+    ("coordinate-1e39", lambda d: bpt_with_line(d, 5, "1e39 0.5 0"), ["line 5", "patch 0", "too large"]),
+    ("coordinate-1e19", lambda d: bpt_with_line(d, 7, "0.5 1e19 0"), ["line 7", "too large"]),
+    ("weight-1e-40", lambda d: bpt_with_line(d, 4, "0.5 0.5 0 1e-40", weights=True), ["line 4", "weight 1e-40", "too small"]),
+    ("weight-1e300", lambda d: bpt_with_line(d, 9, "0.5 0.5 0 1e300", weights=True), ["line 9", "too large"]),
+    ("transform-1e300", lambda d: json_scene(d, [[1e300, 0, 0, 0], [0, 1e300, 0, 0], [0, 0, 1e300, 0], [0, 0, 0, 1]]),
+     ["objects[0].transform", "patch 0", "after the transform", "too large"]),
+    ("stl-byte-flip", lambda d: tetrahedron_stl(d / "m.stl", flip=(5, 1)), ["vertex 15", "too large"]),
+]
+
+
+@pytest.mark.parametrize("case_id, make, fragments", FLOAT32_CASES, ids=[c[0] for c in FLOAT32_CASES])
+def test_input_beyond_float32_is_refused_naming_file_and_place(capsys, tmp_path, case_id, make, fragments):
+    scene = make(tmp_path)
+    out = tmp_path / "out"
+    out.mkdir()
+    code, err = run_cli(capsys, "tessellate", scene, "--eps", "0.01", "-o", out / "m.ply")
+    assert_refused(code, err, [str(scene), *fragments])
+    assert_nothing_written(out)
+
+
+@pytest.mark.parametrize("eps", ["1e-300", "1e-39", "1e39"])
+def test_eps_that_is_not_a_float32_exits_2(capsys, tmp_path, eps):
+    scene = bpt_with_line(tmp_path, 1, "1")
+    out = tmp_path / "out"
+    out.mkdir()
+    code, err = run_cli(capsys, "tessellate", scene, "--eps", eps, "-o", out / "m.ply")
+    assert_refused(code, err, ["eps must be between"])
+    assert_nothing_written(out)
+
+
+BASE_PATCH = np.array([[[i / 3, j / 3, 0.2 * np.sin(i + 2 * j)] for i in range(4)] for j in range(4)])
+
+
+@settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(scale=st.integers(-45, 45), shift=st.integers(-45, 45), weight=st.integers(-45, 45),
+       spread=st.integers(0, 25), relative_eps=st.integers(-12, 3), mesh=st.booleans(),
+       seed=st.integers(0, 2**16))
+def test_every_successful_run_has_finite_output(tessellator, scale, shift, weight, spread, relative_eps, mesh, seed):
+    """Any magnitudes of coordinates, translation, weights and tolerance: the run is refused
+    (SceneError, ValueError) or its whole output is finite."""
+    rng = np.random.default_rng(seed)
+    points = (BASE_PATCH + rng.normal(size=BASE_PATCH.shape) * 0.1) * 10.0**scale + 10.0**shift
+    weights = 10.0 ** (weight + rng.uniform(0, spread, size=(4, 4)))
+    eps = 10.0 ** (scale + relative_eps)
+    with np.errstate(over="ignore", invalid="ignore"):
+        patch = np.concatenate([points * weights[..., None], weights[..., None]], -1)
+    assume(np.isfinite(patch).all() and eps < 1e300)
+    try:
+        if mesh:
+            from cltess.scene import TriangleMesh
+            faces = np.array([[0, 1, 5], [0, 5, 4], [1, 2, 6], [1, 6, 5], [4, 5, 9], [4, 9, 8]])
+            scene = Scene.from_meshes([TriangleMesh(points.reshape(-1, 3), faces)])
+        else:
+            scene = Scene(patch[None], np.zeros(1, np.int32))
+        result = tessellator.tessellate(scene, eps=eps, max_factor=8)
+    except (SceneError, ValueError):
+        return
+    for name in ("positions", "normals", "uv"):
+        assert np.isfinite(getattr(result, name)).all(), name
