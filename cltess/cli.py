@@ -283,6 +283,7 @@ def main(argv: list[str] | None = None) -> int:
     import pyopencl as cl
 
     from cltess.device import DeviceError
+    from cltess.limits import OutputTooLarge
     from cltess.scene import SceneError
 
     try:
@@ -293,6 +294,8 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"{PROG}: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except OutputTooLarge as error:  # a cap or limit the user chose: before MemoryError
+        return _fail(error, EXIT_USAGE)
     except (DeviceError, cl.Error, MemoryError) as error:
         return _fail(error, EXIT_DEVICE)
     except UsageError as error:

@@ -9,7 +9,7 @@ expression (kernels/cltess.h)                   worst case                  type
 ==============================================  ==========================  ======
 quad_vertex_count: f0+f1+f2+f3 + (a-1)(b-1)     4M + (M-1)^2 = (M+1)^2      int
 quad_triangles Bresenham: (2o+1) * along        (2M-1) M                    int
-tri_vertex_count: (n-1)(n-2), before / 2        M^2                         int
+tri_vertex_count: 3M + (n-1)(n-2) / 2          <= M^2 (M >= 5)             int
 tri_triangles Bresenham: 2 (k+1) fe             2 M^2                       int
 put_triangle slot: 3 count + 2                  3 (2M^2 - 1) + 2            uint
 ==============================================  ==========================  ======
@@ -17,7 +17,7 @@ put_triangle slot: 3 count + 2                  3 (2M^2 - 1) + 2            uint
 (a quad patch has at most 2 M^2 triangles, a triangle patch at most M^2).  ``MAX_FACTOR`` is
 the largest M for which all of them fit; a larger ``max_factor`` is refused by
 :func:`check_max_factor`, which both the command line and ``Tessellator`` call.  Global vertex
-numbers are uint32 too (the triangles' indices), so a plan's total must stay below 2^32
+numbers are uint32 too (the triangles' indices), so a plan's total must be at most 2^32
 (:func:`check_totals`); the scan itself runs in uint64.
 
 Floats.  The device computes in float32: input that is finite in float64 but not once rounded
@@ -41,7 +41,7 @@ def kernel_integer_extremes(m: int) -> dict[str, tuple[int, int]]:
     return {
         "quad vertex count (int)": ((m + 1) ** 2, INT32_MAX),
         "quad stitch test (int)": ((2 * m - 1) * m, INT32_MAX),
-        "triangle vertex count (int)": (m * m, INT32_MAX),
+        "triangle vertex count (int)": (max(3 * m + (m - 1) * (m - 2) // 2, (m - 1) * (m - 2)), INT32_MAX),
         "triangle stitch test (int)": (2 * m * m, INT32_MAX),
         "index slot of the last triangle (uint)": (3 * (2 * m * m - 1) + 2, UINT32_MAX),
     }
@@ -109,12 +109,27 @@ def check_max_factor(value) -> int:
     return value
 
 
-def check_totals(name: str, num_vertices: int, num_indices: int) -> None:
-    """A plan's totals: its vertices must be numbered by uint32 triangle indices."""
-    if num_vertices > UINT32_MAX:
-        raise ValueError(f"{name}: the output would have {num_vertices} vertices, more than the "
-                         f"{UINT32_MAX} that 32-bit triangle indices can number; raise the tolerance "
-                         "or lower max_factor")
-    if num_indices // 3 > UINT32_MAX:
-        raise ValueError(f"{name}: the output would have {num_indices // 3} triangles, more than "
-                         f"{UINT32_MAX}; raise the tolerance or lower max_factor")
+class OutputTooLarge(MemoryError, ValueError):
+    """The output cannot be made within what the caller chose (a memory cap, a format that
+    cannot be streamed, 32-bit vertex numbers): a usage error (the command line exits with 2),
+    unlike the device running out of memory.  A MemoryError, as it used to be, and a ValueError."""
+
+
+#: Patches a scene may have: kernels take patch counts as uint and patch-edge counts
+#: (4 per patch) as uint, and patch ids are int32.
+MAX_PATCHES = 2**30 - 1
+
+
+def check_patch_count(name: str, count: int) -> None:
+    if count > MAX_PATCHES:
+        raise OutputTooLarge(f"{name}: {count} patches, more than the {MAX_PATCHES} the kernels number")
+
+
+def check_totals(name: str, num_vertices: int) -> None:
+    """A plan's vertex total (a Python int, summed by the uint64 scan): the triangles number
+    vertices globally in uint32.  Per patch at most (MAX_FACTOR + 1)**2 < 2**30 vertices and
+    6 MAX_FACTOR**2 < 2**32 indices, over at most 2**30 patches: the uint64 scan cannot wrap."""
+    if num_vertices > UINT32_MAX + 1:
+        raise OutputTooLarge(f"{name}: the output would have {num_vertices} vertices, more than the "
+                             f"2**32 that 32-bit triangle indices can number; raise the tolerance or "
+                             "lower max_factor")

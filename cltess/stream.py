@@ -17,6 +17,7 @@ from pathlib import Path
 
 import pyopencl as cl
 
+from .limits import OutputTooLarge
 from .export import ObjWriter, PlyWriter, check_extension, export
 
 COPIES_IN_FLIGHT = 3  # device buffers, host copy, writer records
@@ -56,7 +57,7 @@ def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = 
     ranges = plan.batch_ranges(max(budget // COPIES_IN_FLIGHT, 1))
     if extension not in STREAMING_WRITERS:
         if len(ranges) > 1:
-            raise MemoryError(f"{path}: the output ({plan.output_bytes} bytes) needs {len(ranges)} batches "
+            raise OutputTooLarge(f"{path}: the output ({plan.output_bytes} bytes) needs {len(ranges)} batches "
                               f"under a budget of {budget} bytes, and {extension} cannot be streamed; "
                               "write .ply or .obj, or raise the memory cap")
         tess = tessellator.emit(plan, 0, plan.num_patches, forward_differencing)

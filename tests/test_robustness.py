@@ -296,3 +296,105 @@ def test_every_successful_run_has_finite_output(tessellator, scale, shift, weigh
         return
     for name in ("positions", "normals", "uv"):
         assert np.isfinite(getattr(result, name)).all(), name
+
+
+# --------------------------------------------------------------------------- item 1: sizes
+
+
+def quad_counts_closed_form(f) -> tuple[int, int]:
+    """(vertices, indices) of the quad pattern (kernels/cltess.h quad_triangles), Python ints."""
+    f0, f1, f2, f3 = map(int, f)
+    if f0 == f2 and f1 == f3:
+        return (f0 + 1) * (f1 + 1), 6 * f0 * f1
+    a, b = max(min(f0, f2), 2), max(min(f1, f3), 2)
+    triangles = 2 * (a - 2) * (b - 2) + sum(fe + along - 2 for fe, along in ((f0, a), (f1, b), (f2, a), (f3, b)))
+    return f0 + f1 + f2 + f3 + (a - 1) * (b - 1), 3 * triangles
+
+
+def tri_counts_closed_form(f) -> tuple[int, int]:
+    """(vertices, indices) of the triangle pattern (kernels/cltess.h tri_triangles)."""
+    f = [int(x) for x in f[:3]]
+    n = max(f)
+    t = [int(x < n) for x in f]
+    core = n - sum(t)
+    triangles = core * core + sum(f[e] + (n - 1 - t[(e + 1) % 3]) - t[(e + 2) % 3] for e in range(3) if t[e])
+    return sum(f) + (n - 1) * (n - 2) // 2, 3 * triangles
+
+
+@pytest.mark.parametrize("kind, closed_form", [("bezier", quad_counts_closed_form), ("pn", tri_counts_closed_form)])
+def test_closed_form_counts_are_the_reference_patterns(kind, closed_form):
+    edges = 4 if kind == "bezier" else 3
+    factors = np.array([f + (0,) * (4 - edges) for f in itertools.product(range(1, 7), repeat=edges)])
+    vertices, indices = reference.counts(factors, kind)
+    assert [closed_form(f) for f in factors] == list(zip(vertices.tolist(), indices.tolist()))
+
+
+@pytest.mark.parametrize("m", [1, 2, 3, 5, 8])
+def test_the_worst_case_table_is_the_largest_pattern(m):
+    """limits.kernel_integer_extremes' counts are the largest over all factors in 1..m."""
+    quad = np.array(list(itertools.product(range(1, m + 1), repeat=4)))
+    tri = np.array([f + (0,) for f in itertools.product(range(1, m + 1), repeat=3)])
+    quad_vertices, quad_indices = reference.counts(quad, "bezier")
+    tri_vertices, tri_indices = reference.counts(tri, "pn")
+    worst = limits.kernel_integer_extremes(m)
+    assert quad_vertices.max() == worst["quad vertex count (int)"][0]
+    assert tri_vertices.max() <= worst["triangle vertex count (int)"][0]
+    assert (m - 1) * (m - 2) <= worst["triangle vertex count (int)"][0]  # the product before / 2
+    assert quad_indices.max() - 1 == worst["index slot of the last triangle (uint)"][0]
+    assert tri_indices.max() - 1 <= worst["index slot of the last triangle (uint)"][0]
+
+
+def test_max_factor_is_the_largest_that_fits():
+    assert limits.MAX_FACTOR == 26754
+    assert all(value <= top for value, top in limits.kernel_integer_extremes(limits.MAX_FACTOR).values())
+    assert any(value > top for value, top in limits.kernel_integer_extremes(limits.MAX_FACTOR + 1).values())
+
+
+M = limits.MAX_FACTOR
+EXTREME_FACTORS = {
+    "bezier": [(M, M, M, M), (M, 1, M, 1), (M, M - 1, 2, M - 3), (1, M, 1, M), (M, M, 1, 1), (3, M, M, 2)],
+    "pn": [(M, M, M, 0), (M, M - 1, 3, 0), (1, M, 2, 0), (M, 1, 1, 0), (2, 2, M, 0)],
+}
+
+
+@pytest.mark.parametrize("kind", ["bezier", "pn"])
+def test_device_counts_at_the_largest_factor_are_exact(tessellator, kind):
+    """Stage 3 at max_factor = MAX_FACTOR counts in its 32-bit integers without wrapping."""
+    import pyopencl.array as cl_array
+
+    factors = np.array(EXTREME_FACTORS[kind], np.int32)
+    vertex_offsets, index_offsets, _ = tessellator.stage_counts(cl_array.to_device(tessellator.queue, factors), kind)
+    closed_form = quad_counts_closed_form if kind == "bezier" else tri_counts_closed_form
+    expected = [closed_form(f) for f in factors]
+    assert np.diff(vertex_offsets.get()).tolist() == [v for v, _ in expected]
+    assert np.diff(index_offsets.get()).tolist() == [i for _, i in expected]
+
+
+def curved_patches_bpt(path: Path, count: int) -> Path:
+    """``count`` strongly curved, separate patches: at eps 1e-20 every one saturates."""
+    lines = [str(count)]
+    for p in range(count):
+        lines.append("3 3")
+        lines += [f"{i + 10 * p} {j} {(i - 1.5) ** 2 * (j - 1.5) ** 2}" for j in range(4) for i in range(4)]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_output_beyond_32_bit_vertex_numbers_exits_2(capsys, tmp_path):
+    scene = curved_patches_bpt(tmp_path / "s.bpt", 7)  # 7 (M + 1)^2 > 2^32 vertices
+    out = tmp_path / "out"
+    out.mkdir()
+    code, err = run_cli(capsys, "tessellate", scene, "--eps", "1e-20", "--max-factor", M, "-o", out / "m.ply")
+    assert_refused(code, err, [str(scene), "5010810175 vertices", "2**32"])
+    assert_nothing_written(out)
+
+
+@pytest.mark.parametrize("cap", ["1K", "16M"])
+def test_a_patch_larger_than_the_memory_cap_exits_2(capsys, tmp_path, cap):
+    scene = curved_patches_bpt(tmp_path / "s.bpt", 2)
+    out = tmp_path / "out"
+    out.mkdir()
+    code, err = run_cli(capsys, "tessellate", scene, "--eps", "1e-20", "--max-factor", "2048",
+                        "--max-memory", cap, "-o", out / "m.ply")
+    assert_refused(code, err, [str(scene), "patch 0 alone needs", "raise the cap"])
+    assert_nothing_written(out)
