@@ -217,6 +217,12 @@ def cmd_tessellate(args) -> int:
         verb = "does" if saturated == 1 else "do"
         print(f"{PROG}: warning: {patches} --max-factor {args.max_factor} and {verb} not meet the error "
               "bound; raise --max-factor", file=sys.stderr)
+    if not int(result.stats.get("triangles", 0)):
+        reasons = [f"{result.stats[key]} {label}" for key, label in
+                   (("culled", "outside the camera's view"), ("folded_triangles", "folded mesh triangles"))
+                   if result.stats.get(key)]
+        print(f"{PROG}: warning: {output}: the mesh has no triangles (of {result.stats.get('patches', 0)} "
+              f"patches{': ' + ', '.join(reasons) if reasons else ''})", file=sys.stderr)
     sharp = int(result.stats.get("sharp_edges", 0))
     if sharp and args.sharp_edges == "keep":
         print(f"{PROG}: warning: {sharp} sharp mesh edge{'s' if sharp > 1 else ''} keep each side's own PN "

@@ -34,7 +34,7 @@ import numpy as np
 
 from .limits import float32_problem
 from .meshes import MESH_EXTENSIONS, read_mesh, read_mesh_scene
-from .scene import Camera, Scene, SceneError
+from .scene import Camera, Scene, SceneError, check_scene_file
 
 __all__ = ["load_scene", "read_bpt", "read_bez", "read_json_scene", "write_bpt", "write_bez"]
 
@@ -120,12 +120,11 @@ class _Lines:
 
 
 def _read_text(path) -> str:
+    check_scene_file(path)
     try:
         data = Path(path).read_bytes()
     except FileNotFoundError:
         raise SceneError(f"{path}: file not found") from None
-    except IsADirectoryError:
-        raise SceneError(f"{path}: is a directory, not a scene file") from None
     except OSError as exc:
         raise SceneError(f"{path}: cannot read: {exc.strerror or exc}") from None
     try:

@@ -35,7 +35,7 @@ from .adjacency import (SHARP_EDGE_MODES, EdgeGroups, edge_groups, merge_edge_gr
 from .device import pick_device
 from .limits import OutputTooLarge, check_max_factor, check_patch_count, check_tolerance_value, check_totals
 from .reference import DEFAULT_MAX_FACTOR
-from .scene import Scene
+from .scene import Scene, device_patches
 from .tessellation import Tessellation
 
 STAGES = ("factors", "crack_free", "counts", "vertices", "indices")
@@ -115,7 +115,7 @@ class BezierKind(PatchKind):
         return scene.num_bezier
 
     def prepare(self, scene, sharp_edges="straight"):
-        return KindInput(scene.patches.reshape(-1, 16, 4).astype(np.float32), scene.object_ids,
+        return KindInput(device_patches(scene.patches), scene.object_ids,
                          edge_groups(scene.patches))
 
     def upload(self, queue, source):

@@ -28,6 +28,8 @@ edge  curve     boundary control points, in order      factor of
 from __future__ import annotations
 
 import copy
+import os
+import stat
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -37,6 +39,41 @@ from .limits import float32_problem
 
 class SceneError(ValueError):
     """Bad input: the message names the file and the line, patch or field at fault."""
+
+
+def check_scene_file(path, what: str = "scene file") -> None:
+    """SceneError unless ``path`` is a regular file: not found, a directory, or a device, FIFO
+    or socket (/dev/zero would be read without end, a FIFO would block until a writer comes).
+    os.stat neither blocks nor reads; a symlink loop is named as such."""
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        raise SceneError(f"{path}: file not found") from None
+    except (OSError, ValueError) as exc:  # ELOOP, EACCES, a NUL byte in the name
+        raise SceneError(f"{path}: cannot read: {getattr(exc, 'strerror', None) or exc}") from None
+    if stat.S_ISDIR(mode):
+        raise SceneError(f"{path}: is a directory, not a {what}")
+    if not stat.S_ISREG(mode):
+        kind = "a FIFO" if stat.S_ISFIFO(mode) else "a socket" if stat.S_ISSOCK(mode) else "a device"
+        raise SceneError(f"{path}: is {kind}, not a regular file; give a {what}")
+
+
+def device_patches(patches: np.ndarray) -> np.ndarray:
+    """(P, 4, 4, 4) homogeneous float64 -> (P, 16, 4) float32, what the device evaluates.
+
+    A patch whose 16 Cartesian control points round to one float32 point is collapsed to a
+    point: it becomes that point 16 times with weight 1.  The surface is the same point, and
+    its factors are 1 (two triangles), where float32 rounding of unequal weights far from the
+    origin would otherwise look like curvature and saturate it (issue 9, item 7)."""
+    source = patches.reshape(-1, 16, 4)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        points = (source[..., :3] / source[..., 3:]).astype(np.float32)
+    collapsed = (points == points[:, :1]).all(axis=(1, 2))
+    source = source.astype(np.float32)
+    if collapsed.any():
+        source[collapsed, :, :3] = points[collapsed, :1]
+        source[collapsed, :, 3] = 1.0
+    return source
 
 
 def boundary_curves(patches: np.ndarray) -> np.ndarray:

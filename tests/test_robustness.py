@@ -398,3 +398,111 @@ def test_a_patch_larger_than_the_memory_cap_exits_2(capsys, tmp_path, cap):
                         "--max-memory", cap, "-o", out / "m.ply")
     assert_refused(code, err, [str(scene), "patch 0 alone needs", "raise the cap"])
     assert_nothing_written(out)
+
+
+# --------------------------------------------------------------------------- item 7: smaller things
+
+
+def run_subprocess(*argv, timeout=120):
+    """The real command in a child process (a hang is a failure, not a stuck test run)."""
+    import subprocess
+    import sys
+
+    return subprocess.run([sys.executable, "-m", "cltess", *map(str, argv)], capture_output=True, text=True,
+                          timeout=timeout)
+
+
+@pytest.mark.parametrize("name", ["s.bpt", "s.bez", "s.json", "s.stl", "s.obj"])
+def test_symlink_to_dev_zero_is_refused_unread(tmp_path, name):
+    scene = tmp_path / name
+    scene.symlink_to("/dev/zero")
+    out = tmp_path / "out"
+    out.mkdir()
+    done = run_subprocess("tessellate", scene, "--eps", "0.01", "-o", out / "m.ply", timeout=60)
+    assert_refused(done.returncode, done.stderr, [f"{scene}: is a device, not a regular file"])
+    assert_nothing_written(out)
+
+
+@pytest.mark.parametrize("name", ["s.bpt", "s.ply"])
+def test_fifo_input_is_refused_without_blocking(tmp_path, name):
+    import os
+
+    scene = tmp_path / name
+    os.mkfifo(scene)
+    out = tmp_path / "out"
+    out.mkdir()
+    done = run_subprocess("tessellate", scene, "--eps", "0.01", "-o", out / "m.ply", timeout=60)
+    assert_refused(done.returncode, done.stderr, [f"{scene}: is a FIFO"])
+    assert_nothing_written(out)
+
+
+def test_json_object_behind_a_symlink_loop_names_the_json_file(capsys, tmp_path):
+    (tmp_path / "a.bpt").symlink_to(tmp_path / "b.bpt")
+    (tmp_path / "b.bpt").symlink_to(tmp_path / "a.bpt")
+    scene = tmp_path / "s.json"
+    scene.write_text(json.dumps({"objects": [{"file": "a.bpt"}]}))
+    out = tmp_path / "out"
+    out.mkdir()
+    code, err = run_cli(capsys, "tessellate", scene, "--eps", "0.01", "-o", out / "m.ply")
+    assert_refused(code, err, [f"{scene}: objects[0].file", "a.bpt", "cannot read"])
+    assert_nothing_written(out)
+
+
+@pytest.mark.parametrize("centre", [0.0, 123.4, 1e5])
+def test_a_patch_collapsed_to_a_point_gets_factors_1_and_no_warning(capsys, tmp_path, centre):
+    """Far from the origin, its unequal weights round to unequal float32 points: that is not
+    curvature (it saturated at 64 with a false warning, 8192 zero-area triangles)."""
+    rng = np.random.default_rng(7)
+    lines = ["2", "3 3", *(f"{i / 3} {j / 3} {0.1 * (i - 1.5) ** 2}" for j in range(4) for i in range(4)), "3 3"]
+    lines += [f"{centre!r} {0.7 * centre!r} {-1.3 * centre!r} {w!r}" for w in rng.uniform(0.3, 3, 16).tolist()]
+    scene = tmp_path / "s.bpt"
+    scene.write_text("\n".join(lines) + "\n")
+    out = tmp_path / "m.npz"
+    code, err = run_cli(capsys, "tessellate", scene, "--eps", "0.001", "--max-factor", "64", "-o", out)
+    assert code == 0 and "warning" not in err, err
+    from cltess.export import load_npz
+
+    tess = load_npz(out)
+    assert tess.factors[1].tolist() == [1, 1, 1, 1]
+    assert (tess.patch_ids[tess.triangles[:, 0]] == 1).sum() == 2
+    point = np.float32([centre, 0.7 * centre, -1.3 * centre])
+    assert (tess.positions[tess.patch_ids == 1] == point).all()
+
+
+def test_an_output_without_triangles_warns(capsys, tmp_path):
+    scene = tmp_path / "s.json"
+    scene.write_text(json.dumps({"objects": [{"file": str(TEAPOT)}],
+                                 "camera": {"eye": [0, -20, 5], "target": [0, -40, 5]}}))  # looking away
+    out = tmp_path / "m.ply"
+    code, err = run_cli(capsys, "tessellate", scene, "--pixels", "1", "-o", out)
+    assert code == 0, err
+    assert f"cltess: warning: {out}: the mesh has no triangles (of 32 patches: 32 outside the camera's view)" in err
+    assert out.exists()
+
+
+def test_a_full_disk_names_the_output_file(capsys, tmp_path, monkeypatch):
+    import errno
+    import os
+
+    def full(fd):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(os, "fsync", full)
+    scene = tmp_path / "s.bpt"
+    scene.write_text("\n".join(bpt_lines()) + "\n")
+    out = tmp_path / "out"
+    out.mkdir()
+    code, err = run_cli(capsys, "tessellate", scene, "--eps", "0.01", "-o", out / "m.obj")
+    assert_refused(code, err, [f"{out / 'm.obj'}: cannot write: No space left on device"])
+    assert_nothing_written(out)
+
+
+@pytest.mark.parametrize("folder", ["/sys", "/proc/self"])
+def test_an_unwritable_folder_names_the_output_file(capsys, tmp_path, folder):
+    """Read-only or special file systems (root ignores permission bits, so not a chmod)."""
+    scene = tmp_path / "s.bpt"
+    scene.write_text("\n".join(bpt_lines()) + "\n")
+    target = Path(folder) / "cltess-test.ply"
+    code, err = run_cli(capsys, "tessellate", scene, "--eps", "0.01", "-o", target)
+    assert_refused(code, err, [f"{target}: cannot write: "])
+    assert not target.exists()
