@@ -5,16 +5,20 @@
                       [--sharp-edges {straight,average,keep}] [--device NAME] [--quiet] -o OUT
     cltess bench [SCENES...] [--device NAME] [--repeat N] [--warmup N] [--no-baseline] [--json OUT]
 
-Exit codes: 0 success, 1 OpenCL / device failure, 2 usage or input error, 130 interrupted.
+Exit codes: 0 success, 1 OpenCL / device failure, 2 usage or input error, 130 interrupted
+(Ctrl-C), 143 and 129 for SIGTERM and SIGHUP, which are handled like Ctrl-C.
 Expected errors print ``cltess: error: <message>`` on stderr, without a traceback, and leave
 no output file behind (exports are atomic).
 """
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import os
+import signal
 import sys
+import threading
 from pathlib import Path
 
 from cltess.export import SUPPORTED_EXTENSIONS, check_extension
@@ -293,13 +297,17 @@ def main(argv: list[str] | None = None) -> int:
     from cltess.scene import SceneError
 
     try:
-        args = build_parser().parse_args(argv)
-        return _COMMANDS[args.command](args)
+        with _terminate_like_ctrl_c():
+            args = build_parser().parse_args(argv)
+            return _COMMANDS[args.command](args)
     except SystemExit as done:  # --help / --version
         return done.code if isinstance(done.code, int) else EXIT_OK
     except KeyboardInterrupt:
         print(f"{PROG}: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except Terminated as stop:
+        print(f"{PROG}: {signal.Signals(stop.signum).name}: stopped, nothing written", file=sys.stderr)
+        return 128 + stop.signum
     except OutputTooLarge as error:  # a cap or limit the user chose: before MemoryError
         return _fail(error, EXIT_USAGE)
     except (DeviceError, cl.Error, MemoryError) as error:
@@ -315,6 +323,35 @@ def main(argv: list[str] | None = None) -> int:
         return _fail(message, EXIT_USAGE)
     except RuntimeError as error:  # e.g. an OpenCL program that failed to build
         return _fail(error, EXIT_DEVICE)
+
+
+class Terminated(BaseException):
+    """SIGTERM or SIGHUP arrived: unwinds like Ctrl-C (KeyboardInterrupt), so that the atomic
+    export removes its temporary file, and main exits with 128 + the signal number."""
+
+    def __init__(self, signum: int):
+        super().__init__(signum)
+        self.signum = signum
+
+
+@contextlib.contextmanager
+def _terminate_like_ctrl_c():
+    """SIGTERM and SIGHUP raise Terminated for as long as the command runs (main thread only;
+    the previous handlers come back after)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def stop(signum, frame):
+        raise Terminated(signum)
+
+    signals = [signal.SIGTERM] + ([signal.SIGHUP] if hasattr(signal, "SIGHUP") else [])
+    previous = {signum: signal.signal(signum, stop) for signum in signals}
+    try:
+        yield
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
 
 
 def _fail(error, code: int) -> int:

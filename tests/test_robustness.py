@@ -506,3 +506,36 @@ def test_an_unwritable_folder_names_the_output_file(capsys, tmp_path, folder):
     code, err = run_cli(capsys, "tessellate", scene, "--eps", "0.01", "-o", target)
     assert_refused(code, err, [f"{target}: cannot write: "])
     assert not target.exists()
+
+
+# --------------------------------------------------------------------------- item 6: signals
+
+
+@pytest.mark.parametrize("signame, code", [("SIGTERM", 143), ("SIGHUP", 129), ("SIGINT", 130)])
+def test_a_signal_mid_write_leaves_nothing_and_exits_128_plus_signal(tmp_path, signame, code):
+    """A real run, stopped while it streams a large OBJ into its temporary file."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "out"
+    out.mkdir()
+    child = subprocess.Popen([sys.executable, "-m", "cltess", "tessellate", str(TEAPOT), "--eps", "0.0001",
+                              "--max-factor", "256", "--max-memory", "16M", "-o", str(out / "t.obj")],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 120
+        while not list(out.glob(".t.obj.*.tmp")):  # the writer has started
+            assert child.poll() is None, child.communicate()
+            assert time.monotonic() < deadline, "no temporary file appeared"
+            time.sleep(0.01)
+        time.sleep(0.2)
+        child.send_signal(getattr(signal, signame))
+        _, err = child.communicate(timeout=120)
+    finally:
+        if child.poll() is None:
+            child.kill()
+    assert child.returncode == code, err
+    assert "Traceback" not in err, err
+    assert_nothing_written(out)
