@@ -195,6 +195,7 @@ def cmd_tessellate(args) -> int:
     """Load, tessellate, export, summarise."""
     from cltess.device import pick_device
     from cltess.formats import load_scene
+    from cltess.limits import eps_below_float32
     from cltess.stream import tessellate_to_file
 
     output = Path(args.output)
@@ -203,6 +204,10 @@ def cmd_tessellate(args) -> int:
     if args.pixels is not None and scene.camera is None:
         raise UsageError(f"{args.scene}: --pixels needs a camera in the scene (use a .json scene "
                          "with a \"camera\", or give --eps)")
+    if args.eps is not None:
+        too_fine = eps_below_float32(scene, args.eps)
+        if too_fine:
+            print(f"{PROG}: warning: {args.scene}: {too_fine}", file=sys.stderr)
     device = pick_device(args.device)
 
     from cltess.pipeline import Tessellator  # lazy: builds OpenCL programs

@@ -133,3 +133,33 @@ def check_totals(name: str, num_vertices: int) -> None:
         raise OutputTooLarge(f"{name}: the output would have {num_vertices} vertices, more than the "
                              f"2**32 that 32-bit triangle indices can number; raise the tolerance or "
                              "lower max_factor")
+
+
+#: The output's float32 coordinates resolve a tolerance of at least this many float32 steps at
+#: the scene's largest coordinate.  Evaluating a vertex in float32 and storing it costs a few
+#: steps (de Casteljau on the boundary, the centre added back, the final rounding: up to
+#: sqrt(3)/2 of a step alone; 2-3 steps measured on the translated sphere and teapot), on top of
+#: an approximation error the factors bound by eps: at 16 steps that is at most about 1/5 of eps.
+EPS_FLOAT32_STEPS = 16
+
+
+def largest_coordinate(scene) -> float:
+    """The largest |x|, |y| or |z| the scene's surfaces can reach: of the Bézier patches'
+    Cartesian control points (the surface lies in their hull, weights > 0) and mesh vertices."""
+    extents = [0.0]
+    if len(scene.patches):
+        extents.append(float(np.abs(scene.patches[..., :3] / scene.patches[..., 3:]).max()))
+    extents += [float(np.abs(mesh.vertices).max()) for mesh in scene.meshes]
+    return max(extents)
+
+
+def eps_below_float32(scene, eps: float) -> str | None:
+    """Why ``eps`` is below what float32 output coordinates can represent at the scene's
+    extent (fewer than EPS_FLOAT32_STEPS float32 steps at its largest coordinate), or None."""
+    largest = largest_coordinate(scene)
+    step = float(np.spacing(np.float32(largest)))
+    if eps >= EPS_FLOAT32_STEPS * step:
+        return None
+    return (f"eps {eps:g} is below {EPS_FLOAT32_STEPS} float32 steps ({EPS_FLOAT32_STEPS * step:.3g}) at the "
+            f"scene's largest coordinate, {largest:.6g}: the output's float32 coordinates cannot resolve it, "
+            "so the error bound may not hold; move the scene nearer the origin or raise eps")

@@ -539,3 +539,59 @@ def test_a_signal_mid_write_leaves_nothing_and_exits_128_plus_signal(tmp_path, s
     assert child.returncode == code, err
     assert "Traceback" not in err, err
     assert_nothing_written(out)
+
+
+# --------------------------------------------------------------------------- item 3 (host): eps vs float32
+
+
+def translated(name: str, offset: float) -> tuple[Scene, float]:
+    """A bundled scene moved by (offset, offset, offset), and its bounding-box diagonal."""
+    base = load_scene(REPO / "scenes" / name)
+    points = base.patches[..., :3] / base.patches[..., 3:]
+    patches = base.patches.copy()
+    patches[..., :3] = (points + offset) * patches[..., 3:]
+    return Scene(patches, base.object_ids, name=f"{name} + {offset:g}"), \
+        float(np.linalg.norm(np.ptp(points.reshape(-1, 3), axis=0)))
+
+
+@pytest.mark.parametrize("name, offset, relative_eps", [
+    ("teapot.bez", 0, 1e-3), ("teapot.bez", 1e3, 1e-3), ("teapot.bez", 1e4, 1e-3), ("teapot.bez", 1e5, 1e-3),
+    ("teapot.bez", 1e5, 1e-2), ("sphere.bpt", 1e3, 1e-3), ("sphere.bpt", 1e4, 1e-3), ("sphere.bpt", 3e4, 1e-3),
+    ("sphere.bpt", 1e5, 1e-2), ("teapot.bez", 1e4, 1e-2), ("sphere.bpt", 1e5, 1e-1)])
+def test_far_from_the_origin_the_bound_holds_or_eps_is_flagged(tessellator, name, offset, relative_eps):
+    """Measured against the float64 surface: where the run is not warned about, the bound holds
+    (the unwarned cases must include translated ones, or the test would prove nothing)."""
+    from support import bound_ratio
+
+    scene, diagonal = translated(name, offset)
+    eps = relative_eps * diagonal
+    tess = tessellator.tessellate(scene, eps=eps, max_factor=256)
+    assert tess.stats["saturated"] == 0
+    ratio = bound_ratio(scene.patches, tess, eps)
+    print(f"{scene.name} eps {eps:.3g}: ratio {ratio:.3f}, warned: {bool(limits.eps_below_float32(scene, eps))}")
+    if limits.eps_below_float32(scene, eps) is None:
+        assert ratio <= 1.0
+
+
+def test_the_flag_is_raised_where_the_bound_breaks():
+    scene, diagonal = translated("teapot.bez", 1e5)
+    assert limits.eps_below_float32(scene, 1e-3 * diagonal)  # measured ratio 1.43 there
+    scene, diagonal = translated("sphere.bpt", 3e4)
+    assert limits.eps_below_float32(scene, 1e-3 * diagonal)  # 1.83
+    scene, diagonal = translated("teapot.bez", 1e3)
+    assert limits.eps_below_float32(scene, 1e-3 * diagonal) is None
+
+
+def test_the_cli_warns_before_running_naming_the_scene(capsys, tmp_path):
+    def scene_at(offset):
+        path = tmp_path / f"at{offset:g}.json"
+        path.write_text(json.dumps({"objects": [{"file": str(TEAPOT), "transform": [
+            [1, 0, 0, offset], [0, 1, 0, offset], [0, 0, 1, offset], [0, 0, 0, 1]]}]}))
+        return path
+
+    far = scene_at(1e5)
+    code, err = run_cli(capsys, "tessellate", far, "--eps", "0.008", "-q", "-o", tmp_path / "far.ply")
+    assert code == 0
+    assert f"cltess: warning: {far}: eps 0.008 is below 16 float32 steps (0.125)" in err
+    code, err = run_cli(capsys, "tessellate", scene_at(1e3), "--eps", "0.008", "-q", "-o", tmp_path / "near.ply")
+    assert code == 0 and err == ""
