@@ -459,7 +459,7 @@ def test_a_patch_collapsed_to_a_point_gets_factors_1_and_no_warning(capsys, tmp_
     scene.write_text("\n".join(lines) + "\n")
     out = tmp_path / "m.npz"
     code, err = run_cli(capsys, "tessellate", scene, "--eps", "0.001", "--max-factor", "64", "-o", out)
-    assert code == 0 and "warning" not in err, err
+    assert code == 0 and "does not meet" not in err, err  # (at 1e5, eps is flagged as below float32's steps)
     from cltess.export import load_npz
 
     tess = load_npz(out)
