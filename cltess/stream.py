@@ -54,7 +54,10 @@ def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = 
     budget = max_memory_bytes or default_budget(tessellator.device)
     forward_differencing = options.pop("forward_differencing", True)
     plan = tessellator.plan(scene, **options)
-    ranges = plan.batch_ranges(max(budget // COPIES_IN_FLIGHT, 1))
+    try:
+        ranges = plan.batch_ranges(max(budget // COPIES_IN_FLIGHT, 1))
+    except OutputTooLarge as error:
+        raise OutputTooLarge(f"{error} (a batch may take a third of the memory cap, {budget} bytes)") from None
     if extension not in STREAMING_WRITERS:
         if len(ranges) > 1:
             raise OutputTooLarge(f"{path}: the output ({plan.output_bytes} bytes) needs {len(ranges)} batches "

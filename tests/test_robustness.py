@@ -595,3 +595,44 @@ def test_the_cli_warns_before_running_naming_the_scene(capsys, tmp_path):
     assert f"cltess: warning: {far}: eps 0.008 is below 16 float32 steps (0.125)" in err
     code, err = run_cli(capsys, "tessellate", scene_at(1e3), "--eps", "0.008", "-q", "-o", tmp_path / "near.ply")
     assert code == 0 and err == ""
+
+
+OBJ_TEXT = """v 0 0 0
+v 1 0 0
+v 0 1 0
+v 1 1 0.5
+vn 0 0 1
+vn 0 0 1
+vn 0 0 1
+vn 0 0 1
+f 1//1 2//2 3//3
+f 2//2 4//4 3//3
+"""
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(line=st.integers(0, 9), column=st.integers(0, 3), token=st.one_of(ODD_TOKENS, st.text(max_size=10)))
+def test_obj_with_any_token_loads_or_is_refused_by_name(tmp_path_factory, line, column, token):
+    """Mesh files go through trimesh, which raises anything on bad input: still a SceneError."""
+    assume(not any(0xD800 <= ord(c) <= 0xDFFF for c in token))
+    lines = OBJ_TEXT.splitlines()
+    fields = lines[line].split(" ")
+    fields[min(column, len(fields) - 1)] = token
+    lines[line] = " ".join(fields)
+    path = tmp_path_factory.mktemp("obj") / "m.obj"
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    load_or_scene_error(path)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(at=st.integers(0, 84 + 50 * 24 - 1), value=st.integers(0, 255))
+def test_binary_stl_with_any_byte_changed_loads_or_is_refused_by_name(tmp_path_factory, at, value):
+    import trimesh
+
+    data = bytearray(trimesh.exchange.stl.export_stl(trimesh.creation.box().subdivide()))
+    data[at] = value
+    path = tmp_path_factory.mktemp("stl") / "m.stl"
+    path.write_bytes(bytes(data))
+    scene = load_or_scene_error(path)
+    if scene is not None:  # what loads is usable by the device
+        assert limits.float32_problem(scene.meshes[0].vertices) is None
