@@ -5,16 +5,20 @@
                       [--sharp-edges {straight,average,keep}] [--device NAME] [--quiet] -o OUT
     cltess bench [SCENES...] [--device NAME] [--repeat N] [--warmup N] [--no-baseline] [--json OUT]
 
-Exit codes: 0 success, 1 OpenCL / device failure, 2 usage or input error, 130 interrupted.
+Exit codes: 0 success, 1 OpenCL / device failure, 2 usage or input error, 130 interrupted
+(Ctrl-C), 143 and 129 for SIGTERM and SIGHUP, which are handled like Ctrl-C.
 Expected errors print ``cltess: error: <message>`` on stderr, without a traceback, and leave
 no output file behind (exports are atomic).
 """
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import os
+import signal
 import sys
+import threading
 import warnings
 from pathlib import Path
 
@@ -61,6 +65,15 @@ def _factor(text: str) -> int:
     if value < 1:
         raise argparse.ArgumentTypeError(f"must be >= 1, got {value}")
     return value
+
+
+def _max_factor(text: str) -> int:
+    from cltess.limits import check_max_factor
+
+    try:
+        return check_max_factor(_factor(text))
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error).removeprefix("max_factor ")) from None
 
 
 def _memory_size(text: str) -> int:
@@ -115,7 +128,7 @@ def build_parser() -> argparse.ArgumentParser:
                            help="screen-space tolerance in pixels (needs a camera in the scene)")
     run.add_argument("--no-fd", action="store_true",
                      help="evaluate every vertex directly instead of by forward differencing")
-    run.add_argument("--max-factor", type=_factor, default=DEFAULT_MAX_FACTOR, metavar="N",
+    run.add_argument("--max-factor", type=_max_factor, default=DEFAULT_MAX_FACTOR, metavar="N",
                      help=f"largest edge factor per patch (default {DEFAULT_MAX_FACTOR})")
     run.add_argument("--device", metavar="NAME",
                      help="OpenCL device: substring of platform or device name (default $CLTESS_DEVICE, "
@@ -198,6 +211,7 @@ def cmd_tessellate(args) -> int:
     """Load, tessellate, export, summarise."""
     from cltess.device import pick_device
     from cltess.formats import load_scene
+    from cltess.limits import eps_below_float32
     from cltess.stream import tessellate_to_file
 
     output = Path(args.output)
@@ -206,6 +220,10 @@ def cmd_tessellate(args) -> int:
     if args.pixels is not None and scene.camera is None:
         raise UsageError(f"{args.scene}: --pixels needs a camera in the scene (use a .json scene "
                          "with a \"camera\", or give --eps)")
+    if args.eps is not None:
+        too_fine = eps_below_float32(scene, args.eps)
+        if too_fine:
+            print(f"{PROG}: warning: {args.scene}: {too_fine}", file=sys.stderr)
     device = pick_device(args.device)
 
     from cltess.pipeline import Tessellator  # lazy: builds OpenCL programs
@@ -224,6 +242,12 @@ def cmd_tessellate(args) -> int:
         verb = "does" if saturated == 1 else "do"
         print(f"{PROG}: warning: {patches} --max-factor {args.max_factor} and {verb} not meet the error "
               "bound; raise --max-factor", file=sys.stderr)
+    if not int(result.stats.get("triangles", 0)):
+        reasons = [f"{result.stats[key]} {label}" for key, label in
+                   (("culled", "outside the camera's view"), ("folded_triangles", "folded mesh triangles"))
+                   if result.stats.get(key)]
+        print(f"{PROG}: warning: {output}: the mesh has no triangles (of {result.stats.get('patches', 0)} "
+              f"patches{': ' + ', '.join(reasons) if reasons else ''})", file=sys.stderr)
     sharp = int(result.stats.get("sharp_edges", 0))
     if sharp and args.sharp_edges == "keep":
         print(f"{PROG}: warning: {sharp} sharp mesh edge{'s' if sharp > 1 else ''} keep each side's own PN "
@@ -290,19 +314,26 @@ def main(argv: list[str] | None = None) -> int:
     import pyopencl as cl
 
     from cltess.device import DeviceError
+    from cltess.limits import OutputTooLarge
     from cltess.scene import SceneError
 
     args = None
     try:
-        args = build_parser().parse_args(argv)
-        if not args.verbose:  # pyopencl's "non-empty compiler output" means nothing to a user
-            warnings.filterwarnings("ignore", category=cl.CompilerWarning)
-        return _COMMANDS[args.command](args)
+        with _terminate_like_ctrl_c():
+            args = build_parser().parse_args(argv)
+            if not args.verbose:  # pyopencl's "non-empty compiler output" means nothing to a user
+                warnings.filterwarnings("ignore", category=cl.CompilerWarning)
+            return _COMMANDS[args.command](args)
     except SystemExit as done:  # --help / --version
         return done.code if isinstance(done.code, int) else EXIT_OK
     except KeyboardInterrupt:
         print(f"{PROG}: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except Terminated as stop:
+        print(f"{PROG}: {signal.Signals(stop.signum).name}: stopped, nothing written", file=sys.stderr)
+        return 128 + stop.signum
+    except OutputTooLarge as error:  # a cap or limit the user chose: before MemoryError
+        return _fail(error, EXIT_USAGE)
     except DeviceError as error:
         if error.log and args is not None and args.verbose:
             print(error.log, file=sys.stderr)
@@ -320,6 +351,35 @@ def main(argv: list[str] | None = None) -> int:
         return _fail(message, EXIT_USAGE)
     except RuntimeError as error:  # e.g. an OpenCL program that failed to build
         return _fail(error, EXIT_DEVICE)
+
+
+class Terminated(BaseException):
+    """SIGTERM or SIGHUP arrived: unwinds like Ctrl-C (KeyboardInterrupt), so that the atomic
+    export removes its temporary file, and main exits with 128 + the signal number."""
+
+    def __init__(self, signum: int):
+        super().__init__(signum)
+        self.signum = signum
+
+
+@contextlib.contextmanager
+def _terminate_like_ctrl_c():
+    """SIGTERM and SIGHUP raise Terminated for as long as the command runs (main thread only;
+    the previous handlers come back after)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def stop(signum, frame):
+        raise Terminated(signum)
+
+    signals = [signal.SIGTERM] + ([signal.SIGHUP] if hasattr(signal, "SIGHUP") else [])
+    previous = {signum: signal.signal(signum, stop) for signum in signals}
+    try:
+        yield
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
 
 
 def _fail(error, code: int) -> int:

@@ -88,7 +88,10 @@ def atomic_write(path: str | os.PathLike, mode: str = "wb", **open_kwargs) -> It
     if "w" not in mode:
         raise ValueError(f"atomic_write needs a write mode, got {mode!r}")
     target = Path(path)
-    fd, temp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    try:
+        fd, temp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    except OSError as error:
+        raise _naming(error, target) from error
     handle = None
     try:
         if hasattr(os, "fchmod"):  # mkstemp makes it 0600; give it what a plain open() would
@@ -99,12 +102,20 @@ def atomic_write(path: str | os.PathLike, mode: str = "wb", **open_kwargs) -> It
             handle.flush()
             os.fsync(handle.fileno())
         os.replace(temp_name, target)
-    except BaseException:
+    except BaseException as error:
         if handle is None:
             os.close(fd)  # open() never took the descriptor over
         with contextlib.suppress(FileNotFoundError):
             os.unlink(temp_name)
+        if isinstance(error, OSError) and error.filename in (None, temp_name):
+            raise _naming(error, target) from error
         raise
+
+
+def _naming(error: OSError, target: Path) -> OSError:
+    """The same error (class, errno) naming the output file rather than the temporary one or
+    none (a full disk, a read-only file system)."""
+    return type(error)(error.errno, f"cannot write: {error.strerror or error}", os.fspath(target))
 
 
 # --------------------------------------------------------------------------- checks
@@ -148,7 +159,7 @@ def _face_array(triangles, num_vertices: int) -> np.ndarray:
 class _StreamingWriter:
     """Shared bookkeeping: declared totals, counts written so far, the atomic target file."""
 
-    def __init__(self, path: str | os.PathLike, num_vertices: int, num_faces: int, text: bool):
+    def __init__(self, path: str | os.PathLike, num_vertices: int, num_faces: int):
         if num_vertices < 0 or num_faces < 0:
             raise ValueError("vertex and face totals must be non-negative")
         self.path = Path(path)
@@ -156,9 +167,9 @@ class _StreamingWriter:
         self.num_faces = int(num_faces)
         self.vertices_written = 0
         self.faces_written = 0
-        self._atomic = atomic_write(self.path, "w" if text else "wb",
-                                    **({"encoding": "ascii", "newline": "\n"} if text else {}))
+        self._atomic = atomic_write(self.path, "wb")
         self._file: IO | None = None
+        self._face_spool: IO | None = None
 
     def __enter__(self):
         self._file = self._atomic.__enter__()
@@ -182,8 +193,25 @@ class _StreamingWriter:
         return False
 
     def _abort(self, error: BaseException) -> None:
-        """Remove the temporary file; the caller re-raises ``error``."""
+        """Remove the temporary files; the caller re-raises ``error``."""
+        self._close_spool()
         self._atomic.__exit__(type(error), error, error.__traceback__)
+
+    def _put_faces(self, data: bytes) -> None:
+        """Face records go after every vertex: straight into the file once all vertices are
+        written, else to an anonymous spool appended at the end.  So the file does not depend
+        on how the mesh was cut into blocks."""
+        if self.vertices_written == self.num_vertices and self._face_spool is None:
+            self._file.write(data)
+            return
+        if self._face_spool is None:
+            self._face_spool = tempfile.TemporaryFile(dir=self.path.parent)
+        self._face_spool.write(data)
+
+    def _close_spool(self) -> None:
+        if self._face_spool is not None:
+            self._face_spool.close()
+            self._face_spool = None
 
     def _take_vertices(self, block) -> VertexBlock:
         arrays = _vertex_arrays(block)
@@ -211,6 +239,10 @@ class _StreamingWriter:
 
     def _finish(self) -> None:
         self._check_totals()
+        if self._face_spool is not None:
+            self._face_spool.seek(0)
+            shutil.copyfileobj(self._face_spool, self._file, 1 << 24)
+            self._close_spool()
 
 
 # --------------------------------------------------------------------------- PLY
@@ -224,10 +256,6 @@ class PlyWriter(_StreamingWriter):
     Face blocks that arrive before the last vertex block are spooled to an anonymous
     temporary file and appended after the vertices when the writer closes.
     """
-
-    def __init__(self, path: str | os.PathLike, num_vertices: int, num_faces: int):
-        super().__init__(path, num_vertices, num_faces, text=False)
-        self._face_spool: IO | None = None
 
     def header(self) -> bytes:
         lines = [
@@ -265,28 +293,7 @@ class PlyWriter(_StreamingWriter):
         records = np.empty(len(faces), PLY_FACE_DTYPE)
         records["count"] = 3
         records["vertex_indices"] = faces
-        if self.vertices_written == self.num_vertices and self._face_spool is None:
-            self._file.write(records.view(np.uint8))
-            return
-        if self._face_spool is None:
-            self._face_spool = tempfile.TemporaryFile(dir=self.path.parent)
-        self._face_spool.write(records.view(np.uint8))
-
-    def _finish(self) -> None:
-        self._check_totals()
-        if self._face_spool is not None:
-            self._face_spool.seek(0)
-            shutil.copyfileobj(self._face_spool, self._file, 1 << 24)
-            self._close_spool()
-
-    def _abort(self, error: BaseException) -> None:
-        self._close_spool()
-        super()._abort(error)
-
-    def _close_spool(self) -> None:
-        if self._face_spool is not None:
-            self._face_spool.close()
-            self._face_spool = None
+        self._put_faces(records.tobytes())
 
 
 # --------------------------------------------------------------------------- OBJ
@@ -299,31 +306,30 @@ def _format_rows(template: str, values: np.ndarray) -> str:
 
 
 class ObjWriter(_StreamingWriter):
-    """Wavefront OBJ, written in blocks: ``v``, ``vt``, ``vn`` lines per vertex block and
-    ``f a/a/a b/b/b c/c/c`` (1-based, position/uv/normal share the index) per face block.
+    """Wavefront OBJ, written in blocks: per vertex a ``v``, a ``vt`` and a ``vn`` line, then
+    ``f a/a/a b/b/b c/c/c`` per face (1-based, position/uv/normal share the index).
 
-    Floats are written with 9 significant digits, so float32 values read back exactly.
-    Faces may only refer to vertices written before them (checked).
+    Floats are written with 9 significant digits, so float32 values read back exactly.  Faces
+    may only refer to vertices written before them (checked); like PLY's, face blocks that
+    arrive before the last vertex block are spooled and appended after the vertices, so a
+    mesh written in any blocks gives the same bytes.
     """
-
-    def __init__(self, path: str | os.PathLike, num_vertices: int, num_faces: int):
-        super().__init__(path, num_vertices, num_faces, text=True)
 
     def _write_header(self) -> None:
         self._file.write(
             "# written by cltess\n"
             f"# {self.num_vertices} vertices, {self.num_faces} triangles\n"
             "# per vertex: v (position), vt (patch u v), vn (normal); faces: f v/vt/vn, 1-based\n"
-        )
+            .encode("ascii"))
 
     def write_vertices(self, block) -> None:
         """Append vertices: ``block`` has positions (k,3), normals (k,3), uv (k,2) (ids are not written)."""
         arrays = self._take_vertices(block)
-        for start in range(0, len(arrays.positions), OBJ_BLOCK_ROWS):
-            rows = slice(start, start + OBJ_BLOCK_ROWS)
-            self._file.write(_format_rows("v %.9g %.9g %.9g\n", arrays.positions[rows]))
-            self._file.write(_format_rows("vt %.9g %.9g\n", arrays.uv[rows]))
-            self._file.write(_format_rows("vn %.9g %.9g %.9g\n", arrays.normals[rows]))
+        rows = np.hstack([arrays.positions, arrays.uv, arrays.normals])
+        for start in range(0, len(rows), OBJ_BLOCK_ROWS):
+            text = _format_rows("v %.9g %.9g %.9g\nvt %.9g %.9g\nvn %.9g %.9g %.9g\n",
+                                rows[start:start + OBJ_BLOCK_ROWS])
+            self._file.write(text.encode("ascii"))
 
     def write_faces(self, triangles) -> None:
         """Append faces: (k, 3) global, 0-based vertex indices of vertices already written."""
@@ -333,7 +339,7 @@ class ObjWriter(_StreamingWriter):
         line = "f {0}/{0}/{0} {1}/{1}/{1} {2}/{2}/{2}\n".format
         for start in range(0, len(faces), OBJ_BLOCK_ROWS):
             one_based = faces[start:start + OBJ_BLOCK_ROWS].astype(np.int64) + 1
-            self._file.write("".join(map(line, *one_based.T.tolist())))
+            self._put_faces("".join(map(line, *one_based.T.tolist())).encode("ascii"))
 
 
 # --------------------------------------------------------------------------- NPZ

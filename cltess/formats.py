@@ -32,8 +32,9 @@ from pathlib import Path
 
 import numpy as np
 
+from .limits import float32_problem
 from .meshes import MESH_EXTENSIONS, read_mesh, read_mesh_scene
-from .scene import Camera, Scene, SceneError
+from .scene import Camera, Scene, SceneError, check_scene_file
 
 __all__ = ["load_scene", "read_bpt", "read_bez", "read_json_scene", "write_bpt", "write_bez"]
 
@@ -41,9 +42,10 @@ __all__ = ["load_scene", "read_bpt", "read_bez", "read_json_scene", "write_bpt",
 # line-by-line diagnosis (numpy would accept "1_0", "nan" or non-ASCII digits).
 _FLOAT_BLOCK_BAD = re.compile(r"[^0-9eE.+\-,\s]")
 _INDEX_BLOCK_BAD = re.compile(r"[^0-9+\-,\s]")
-_FLOAT_TOKEN = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
-_NONFINITE_TOKEN = re.compile(r"[+-]?(?:nan|inf|infinity)", re.IGNORECASE)
-_INT_TOKEN = re.compile(r"[+-]?\d+")
+# re.ASCII: \d alone would take any Unicode digit ("\uff11"), which float() and int() accept too.
+_FLOAT_TOKEN = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)
+_NONFINITE_TOKEN = re.compile(r"[+-]?(?:nan|inf|infinity)", re.IGNORECASE | re.ASCII)
+_INT_TOKEN = re.compile(r"[+-]?\d+", re.ASCII)
 
 _BPT_LINES_PER_PATCH = 17  # "3 3" + 16 points
 _INT32_MAX = 2**31 - 1
@@ -79,7 +81,7 @@ class _Lines:
 
     def __init__(self, name: str, text: str):
         self.name = name
-        raw = text.splitlines()
+        raw = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")  # lines as editors count them (not at \f, \x1c, ...)
         self.numbers = [k for k, line in enumerate(raw, 1) if line and not line.isspace()]
         self.texts = [raw[k - 1] for k in self.numbers]
 
@@ -100,7 +102,7 @@ class _Lines:
         tokens = self.texts[k].split()
         if len(tokens) != 1 or not _INT_TOKEN.fullmatch(tokens[0]):
             raise self.error(k, f"expected the {what} count (one integer), got {self.texts[k].strip()[:60]!r}")
-        n = int(tokens[0])
+        n = _clamped_int(tokens[0])
         if n <= 0:
             raise self.error(k, f"{what} count is {n}; need at least one")
         left = len(self) - k - 1
@@ -118,12 +120,11 @@ class _Lines:
 
 
 def _read_text(path) -> str:
+    check_scene_file(path)
     try:
         data = Path(path).read_bytes()
     except FileNotFoundError:
         raise SceneError(f"{path}: file not found") from None
-    except IsADirectoryError:
-        raise SceneError(f"{path}: is a directory, not a scene file") from None
     except OSError as exc:
         raise SceneError(f"{path}: cannot read: {exc.strerror or exc}") from None
     try:
@@ -135,6 +136,16 @@ def _read_text(path) -> str:
     if not text.strip():
         raise SceneError(f"{path}: empty file")
     return text
+
+
+def _clamped_int(token: str) -> int:
+    """An ASCII integer token (``_INT_TOKEN``) as an int clamped to +-2**62, without converting
+    thousands of digits (which Python refuses above sys.get_int_max_str_digits())."""
+    token = token.strip()
+    digits = token.lstrip("+-").lstrip("0")
+    if len(digits) > 18:
+        return -(2**62) if token.startswith("-") else 2**62
+    return int(token)
 
 
 def _token_problem(token: str) -> str | None:
@@ -165,7 +176,8 @@ def _floats(lines: _Lines, ks, rows: list[list[str]]) -> np.ndarray:
             problem = _token_problem(token)
             if problem:
                 raise lines.error(k, problem)
-    raise AssertionError("unreachable: block failed to convert but every token is fine")
+    # every token is an ASCII float numpy did not take (e.g. whitespace it does not strip)
+    return np.array([[float(token) for token in row] for row in rows], dtype=np.float64)
 
 
 def _homogeneous(xyzw: np.ndarray) -> np.ndarray:
@@ -206,7 +218,12 @@ def _parse_bpt(lines: _Lines) -> np.ndarray:
         r = int(bad[0])
         raise lines.error(point_ks[r], f"patch {r // 16}: weight {float(weights[r])!r} <= 0 (weights must be positive)")
     lines.no_trailing(1 + num * _BPT_LINES_PER_PATCH, "patch")
-    return _homogeneous(values.reshape(num, 4, 4, 4))
+    homogeneous = _homogeneous(values)
+    problem = float32_problem(homogeneous)
+    if problem:
+        r, what = problem
+        raise lines.error(point_ks[r], f"patch {r // 16}: {what}")
+    return homogeneous.reshape(num, 4, 4, 4)
 
 
 # --------------------------------------------------------------------------- .bez
@@ -242,7 +259,12 @@ def _parse_bez(lines: _Lines) -> np.ndarray:
         r = int(np.argmax(values[:, 3] <= 0))
         raise lines.error(first + r, f"vertex {r + 1}: weight {float(values[r, 3])!r} <= 0 (weights must be positive)")
     lines.no_trailing(first + num_vertices, "vertex")
-    return _homogeneous(values)[indices - 1].reshape(num, 4, 4, 4)
+    homogeneous = _homogeneous(values)
+    problem = float32_problem(homogeneous)
+    if problem:
+        r, what = problem
+        raise lines.error(first + r, f"vertex {r + 1}: {what}")
+    return homogeneous[indices - 1].reshape(num, 4, 4, 4)
 
 
 def _indices(lines: _Lines, first: int, rows: list[list[str]], num_vertices: int) -> np.ndarray:
@@ -263,7 +285,7 @@ def _indices(lines: _Lines, first: int, rows: list[list[str]], num_vertices: int
                 kind = "non-integer vertex index" if _FLOAT_TOKEN.fullmatch(t) else "not a vertex index"
                 raise lines.error(first + r, f"patch {r}: {kind}: {t[:40]!r}")
         # every token is an integer: numpy overflowed on a huge one
-        values = np.array([[max(min(int(t), 2**62), -(2**62)) for t in row] for row in rows], dtype=np.int64)
+        values = np.array([[_clamped_int(t) for t in row] for row in rows], dtype=np.int64)
     bad = (values < 1) | (values > num_vertices)
     if bad.any():
         r, c = np.argwhere(bad)[0]
@@ -317,16 +339,18 @@ def read_json_scene(path) -> Scene:
         if not _is_int(object_id) or not 0 <= object_id <= _INT32_MAX:
             raise where.error(f"{key}.object_id", f"must be an integer in 0..{_INT32_MAX}, got {object_id!r}")
         file_path = folder / file
-        resolved = file_path.resolve()
-        if resolved not in cache:
-            try:
+        try:
+            resolved = file_path.resolve()
+            if resolved not in cache:
                 if ext in MESH_EXTENSIONS:
                     cache[resolved] = read_mesh(file_path)
                 else:
                     lines = _Lines.read(file_path)
                     cache[resolved] = _parse_bpt(lines) if ext == ".bpt" else _parse_bez(lines)
-            except SceneError as exc:
-                raise where.error(f"{key}.file", str(exc)) from None
+        except SceneError as exc:
+            raise where.error(f"{key}.file", str(exc)) from None
+        except (OSError, RuntimeError, ValueError) as exc:  # a symlink loop, a NUL in the name
+            raise where.error(f"{key}.file", f"{str(file_path)!r}: cannot read: {exc}") from None
         source = cache[resolved]
         instanced_bytes += source.patches.nbytes if isinstance(source, Scene) else (
             source.nbytes if isinstance(source, np.ndarray) else
@@ -426,13 +450,22 @@ def _is_number(value) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
+def _finite(value) -> float | None:
+    """A JSON number as a finite float, or None (an integer too large for a float included)."""
+    try:
+        number = float(value)
+    except OverflowError:
+        return None
+    return number if math.isfinite(number) else None
+
+
 def _vector(value, where: _Where, key: str, size: int) -> np.ndarray:
     if not isinstance(value, list) or len(value) != size or not all(_is_number(x) for x in value):
         raise where.error(key, f"must be a list of {size} numbers, got {json.dumps(value)[:60]}")
-    vec = np.array(value, dtype=np.float64)
-    if not np.isfinite(vec).all():
-        raise where.error(key, "values must be finite")
-    return vec
+    numbers = [_finite(x) for x in value]
+    if None in numbers:
+        raise where.error(key, f"values must be finite numbers, got {str(value[numbers.index(None)])[:40]}")
+    return np.array(numbers, dtype=np.float64)
 
 
 def _transform(value, where: _Where, key: str) -> np.ndarray:
@@ -457,6 +490,10 @@ def _check_transformed(patches: np.ndarray, where: _Where, key: str) -> None:
     if not positive.all():
         p = int(np.argmin(positive))
         raise where.error(key, f"patch {p}: weight {float(patches[p, ..., 3].min())!r} <= 0 after the transform")
+    problem = float32_problem(patches.reshape(-1, 4))
+    if problem:
+        r, what = problem
+        raise where.error(key, f"patch {r // 16}: after the transform, {what}")
 
 
 def _camera(value, where: _Where) -> Camera:
@@ -478,7 +515,7 @@ def _camera(value, where: _Where) -> Camera:
             setattr(cam, name, value[name])
     for name in ("fov_y_deg", "near", "far"):
         if name in value:
-            if not _is_number(value[name]) or not math.isfinite(value[name]):
+            if not _is_number(value[name]) or _finite(value[name]) is None:
                 raise where.error(f"{key}.{name}", f"must be a finite number, got {value[name]!r}")
             setattr(cam, name, float(value[name]))
     if not 0 < cam.fov_y_deg < 180:

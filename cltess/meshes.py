@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .scene import Scene, SceneError, TriangleMesh
+from .scene import Scene, SceneError, TriangleMesh, check_scene_file
 
 __all__ = ["MESH_EXTENSIONS", "read_mesh", "read_mesh_scene"]
 
@@ -33,10 +33,7 @@ def read_mesh(path, object_id: int = 0) -> TriangleMesh:
 
     name = str(path)
     file = Path(path)
-    if not file.exists():
-        raise SceneError(f"{name}: file not found")
-    if file.is_dir():
-        raise SceneError(f"{name}: is a directory, not a mesh file")
+    check_scene_file(name, "mesh file")
     if file.suffix.lower() == ".stl":
         _check_binary_stl(file, name)
     # trimesh logs, and without scipy prints tracebacks for, fallbacks it takes: keep it quiet.

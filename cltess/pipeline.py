@@ -33,8 +33,9 @@ from . import reference
 from .adjacency import (SHARP_EDGE_MODES, EdgeGroups, edge_groups, merge_edge_groups, mesh_edge_groups,
                         pn_edge_normals)
 from .device import BuildError, first_error_line, pick_device
+from .limits import OutputTooLarge, check_max_factor, check_patch_count, check_tolerance_value, check_totals
 from .reference import DEFAULT_MAX_FACTOR
-from .scene import Scene
+from .scene import Scene, device_patches
 from .tessellation import Tessellation
 
 STAGES = ("factors", "crack_free", "counts", "vertices", "indices")
@@ -114,7 +115,7 @@ class BezierKind(PatchKind):
         return scene.num_bezier
 
     def prepare(self, scene, sharp_edges="straight"):
-        return KindInput(scene.patches.reshape(-1, 16, 4).astype(np.float32), scene.object_ids,
+        return KindInput(device_patches(scene.patches), scene.object_ids,
                          edge_groups(scene.patches))
 
     def upload(self, queue, source):
@@ -309,9 +310,7 @@ class Tessellator:
             final, [(part.kind, part.base, part.count) for part in parts])
         num_vertices = int(vertex_offsets[count].get())  # the two read-backs
         num_indices = int(index_offsets[count].get())
-        if num_vertices >= 2**32:
-            raise MemoryError(f"{scene.name}: {num_vertices} vertices do not fit 32-bit indices; "
-                              "raise the tolerance or lower --max-factor")
+        check_totals(scene.name, num_vertices)
         flag_values = flags.get()
         stats = {
             "patches": count,
@@ -514,13 +513,13 @@ class Plan:
         """Consecutive patch ranges whose vertex + index output fits max_output_bytes each."""
         if self.output_bytes <= max_output_bytes:
             return [(0, self.num_patches)]
-        size = (self._offsets("vertex_offsets") * BYTES_PER_VERTEX
-                + self._offsets("index_offsets") * BYTES_PER_INDEX).astype(np.int64)
+        size = (self._offsets("vertex_offsets").astype(np.int64) * BYTES_PER_VERTEX
+                + self._offsets("index_offsets").astype(np.int64) * BYTES_PER_INDEX)  # < 2**40: check_totals
         per_patch = np.diff(size)
         if per_patch.max() > max_output_bytes:
             worst = int(per_patch.argmax())
-            raise MemoryError(f"{self.name}: patch {worst} alone needs {per_patch[worst]} bytes of output, "
-                              f"more than the cap of {max_output_bytes}; lower max_factor or raise the cap")
+            raise OutputTooLarge(f"{self.name}: patch {worst} alone needs {per_patch[worst]} bytes of output, "
+                                 f"more than the cap of {max_output_bytes}; lower max_factor or raise the cap")
         ranges, first = [], 0
         while first < self.num_patches:
             last = int(np.searchsorted(size, size[first] + max_output_bytes, side="right")) - 1
@@ -537,12 +536,13 @@ def _check_tolerance(scene: Scene, eps, pixels, max_factor) -> None:
     name = "eps" if eps is not None else "pixels"
     if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
         raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+    check_tolerance_value(name, value)
     if pixels is not None and scene.camera is None:
         raise ValueError(f"{scene.name}: a pixel tolerance needs a camera in the scene")
-    if int(max_factor) < 1:
-        raise ValueError(f"max_factor must be >= 1, got {max_factor}")
+    check_max_factor(max_factor)
     if scene.num_patches == 0:
         raise ValueError(f"{scene.name}: the scene has no patches")
+    check_patch_count(scene.name, scene.num_patches)
 
 
 def _camera_arguments(camera):

@@ -28,13 +28,52 @@ edge  curve     boundary control points, in order      factor of
 from __future__ import annotations
 
 import copy
+import os
+import stat
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from .limits import float32_problem
+
 
 class SceneError(ValueError):
     """Bad input: the message names the file and the line, patch or field at fault."""
+
+
+def check_scene_file(path, what: str = "scene file") -> None:
+    """SceneError unless ``path`` is a regular file: not found, a directory, or a device, FIFO
+    or socket (/dev/zero would be read without end, a FIFO would block until a writer comes).
+    os.stat neither blocks nor reads; a symlink loop is named as such."""
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        raise SceneError(f"{path}: file not found") from None
+    except (OSError, ValueError) as exc:  # ELOOP, EACCES, a NUL byte in the name
+        raise SceneError(f"{path}: cannot read: {getattr(exc, 'strerror', None) or exc}") from None
+    if stat.S_ISDIR(mode):
+        raise SceneError(f"{path}: is a directory, not a {what}")
+    if not stat.S_ISREG(mode):
+        kind = "a FIFO" if stat.S_ISFIFO(mode) else "a socket" if stat.S_ISSOCK(mode) else "a device"
+        raise SceneError(f"{path}: is {kind}, not a regular file; give a {what}")
+
+
+def device_patches(patches: np.ndarray) -> np.ndarray:
+    """(P, 4, 4, 4) homogeneous float64 -> (P, 16, 4) float32, what the device evaluates.
+
+    A patch whose 16 Cartesian control points round to one float32 point is collapsed to a
+    point: it becomes that point 16 times with weight 1.  The surface is the same point, and
+    its factors are 1 (two triangles), where float32 rounding of unequal weights far from the
+    origin would otherwise look like curvature and saturate it (issue 9, item 7)."""
+    source = patches.reshape(-1, 16, 4)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        points = (source[..., :3] / source[..., 3:]).astype(np.float32)
+    collapsed = (points == points[:, :1]).all(axis=(1, 2))
+    source = source.astype(np.float32)
+    if collapsed.any():
+        source[collapsed, :, :3] = points[collapsed, :1]
+        source[collapsed, :, 3] = 1.0
+    return source
 
 
 def boundary_curves(patches: np.ndarray) -> np.ndarray:
@@ -159,6 +198,9 @@ class TriangleMesh:
         if bad.any():
             v = int(np.argmax(bad))
             raise SceneError(f"{name}: vertex {v}: position {vertices[v].tolist()} is not finite")
+        problem = float32_problem(vertices)
+        if problem:
+            raise SceneError(f"{name}: vertex {problem[0]}: {problem[1]}")
         faces = np.asarray(self.faces)
         if faces.size == 0:
             raise SceneError(f"{name}: the mesh has no faces (PN triangles need triangles)")
@@ -220,6 +262,9 @@ class TriangleMesh:
         bad = ~np.isfinite(out.vertices).all(axis=1)
         if bad.any():
             raise ValueError(f"vertex {int(np.argmax(bad))}: not finite after the transform")
+        problem = float32_problem(out.vertices)
+        if problem:
+            raise ValueError(f"vertex {problem[0]}: after the transform, {problem[1]}")
         if np.linalg.det(matrix[:3, :3]) < 0:  # a mirror: keep the winding with the normals
             out.faces = self.faces[:, ::-1].copy()
         if object_id is not None:
@@ -271,6 +316,12 @@ class Scene:
             raise SceneError(f"{self.name}: patches must have shape (P, 4, 4, 4), got {self.patches.shape}")
         if self.object_ids.shape != (len(self.patches),):
             raise SceneError(f"{self.name}: need one object id per patch")
+        if not np.isfinite(self.patches).all():
+            raise SceneError(f"{self.name}: patch {int(np.argmin(np.isfinite(self.patches).all(axis=(1, 2, 3))))}: "
+                             "control points must be finite")
+        problem = float32_problem(self.patches.reshape(-1, 4))
+        if problem:
+            raise SceneError(f"{self.name}: patch {problem[0] // 16}: {problem[1]}")
         self.meshes = tuple(self.meshes)
         if not all(isinstance(mesh, TriangleMesh) for mesh in self.meshes):
             raise SceneError(f"{self.name}: meshes must be TriangleMesh objects")

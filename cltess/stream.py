@@ -17,6 +17,7 @@ from pathlib import Path
 
 import pyopencl as cl
 
+from .limits import OutputTooLarge
 from .export import ObjWriter, PlyWriter, check_extension, export
 
 COPIES_IN_FLIGHT = 3  # device buffers, host copy, writer records
@@ -53,10 +54,13 @@ def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = 
     budget = max_memory_bytes or default_budget(tessellator.device)
     forward_differencing = options.pop("forward_differencing", True)
     plan = tessellator.plan(scene, **options)
-    ranges = plan.batch_ranges(max(budget // COPIES_IN_FLIGHT, 1))
+    try:
+        ranges = plan.batch_ranges(max(budget // COPIES_IN_FLIGHT, 1))
+    except OutputTooLarge as error:
+        raise OutputTooLarge(f"{error} (a batch may take a third of the memory cap, {budget} bytes)") from None
     if extension not in STREAMING_WRITERS:
         if len(ranges) > 1:
-            raise MemoryError(f"{path}: the output ({plan.output_bytes} bytes) needs {len(ranges)} batches "
+            raise OutputTooLarge(f"{path}: the output ({plan.output_bytes} bytes) needs {len(ranges)} batches "
                               f"under a budget of {budget} bytes, and {extension} cannot be streamed; "
                               "write .ply or .obj, or raise the memory cap")
         tess = tessellator.emit(plan, 0, plan.num_patches, forward_differencing)

@@ -19,6 +19,7 @@ import trimesh
 from cltess import cli
 from cltess.cli import main
 from cltess.device import DEVICE_ENV_VAR, list_devices
+from cltess.limits import OutputTooLarge
 from cltess.scene import Scene
 from cltess.tessellation import Tessellation
 from device_faults import UNKNOWN_CPU_LOG, UNKNOWN_CPU_REASON, fresh_probes, pocl_fails_to_build
@@ -325,6 +326,7 @@ def test_saturated_patches_warn_even_when_quiet(capsys, tmp_path, scene_file, fa
     (cl.RuntimeError("clEnqueueNDRangeKernel failed: OUT_OF_RESOURCES"), 1, "OUT_OF_RESOURCES"),
     (RuntimeError("kernels/factors.cl failed to build"), 1, "failed to build"),
     (MemoryError("too many vertices"), 1, "too many vertices"),
+    (OutputTooLarge("over the cap"), 2, "over the cap"),  # a cap the user chose
 ])
 def test_pipeline_errors_map_to_exit_codes(capsys, tmp_path, scene_file, fake_pipeline, failure, code, fragment):
     fake_pipeline.result = failure

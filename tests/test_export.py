@@ -254,6 +254,8 @@ def test_streamed_obj_batches_read_back(tess, tmp_path, block_size):
         for block, faces in blocks_of(tess, block_size):
             writer.write_vertices(block)
             writer.write_faces(faces)
+    assert streamed.read_bytes() == export(tess, tmp_path / "whole.obj").read_bytes()
+    (tmp_path / "whole.obj").unlink()
     obj = read_obj(streamed)
     np.testing.assert_array_equal(bits(obj["v"]), bits(tess.positions))
     np.testing.assert_array_equal(bits(obj["vn"]), bits(tess.normals))
