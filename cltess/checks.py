@@ -17,9 +17,9 @@ when d2 = v - a is t * d1, d1 = b - a, for some 0 < t < 1:
 * betweenness: 0 < d2_k / d1_k < 1 along an axis k with d1_k != 0, by exact comparisons.
 
 Candidate pairs come from a uniform grid (a sort-based join, vectorised): cells of the median
-edge extent, every vertex in its cell, every edge cut into pieces no longer than a cell and
-entered in the cells its (slightly padded) box covers; then the vertex must lie in the edge's
-box, and the exact test decides.
+edge extent, the vertices sorted by cell, every edge cut into pieces no longer than a cell whose
+(slightly padded) boxes look up the cells they cover; then the vertex must lie in the edge's
+box, and the exact test decides.  About 8 s for a million triangles on one busy CPU core.
 """
 from __future__ import annotations
 
@@ -99,19 +99,6 @@ def strictly_inside(v: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return out
 
 
-def _cell_entries(lo, hi, h, origin):
-    """(entry owner (N,), cell (N, 3) int64) of boxes lo..hi (B, 3) in cells of size h."""
-    first = np.floor((lo - origin) / h).astype(np.int64)
-    last = np.floor((hi - origin) / h).astype(np.int64)
-    span = last - first + 1
-    owners, cells = [], []
-    for offset in np.ndindex(*span.max(axis=0)):
-        take = np.flatnonzero((np.array(offset) < span).all(axis=1))
-        owners.append(take)
-        cells.append(first[take] + np.array(offset))
-    return np.concatenate(owners), np.concatenate(cells)
-
-
 def _edge_pieces(a, b, h):
     """(edge (N,), lo (N, 3), hi (N, 3)): each edge a-b cut into pieces of extent <= h, the
     boxes of the pieces padded against the rounding of their computed ends."""
@@ -130,46 +117,48 @@ def _edge_pieces(a, b, h):
 
 def _candidates(points, objects, edges, chunk):
     """Chunks of candidate pairs (vertex (N,), edge (N,)) of the same object, the vertex in the
-    edge's closed box and not one of its ends: a uniform grid of the median edge extent, joined
-    by sorting (every vertex against the edge pieces entered in its cell)."""
+    edge's closed box and not one of its ends.  A uniform grid of the median edge extent: the
+    vertices sorted by cell; every edge cut into pieces no longer than a cell, and each cell
+    that a piece's box covers (at most 2 per axis, 3 where the padding crosses a cell wall)
+    looked up in the sorted vertices."""
     a, b = points[edges[:, 0]], points[edges[:, 1]]
     h = float(np.median(np.abs(b - a).max(axis=1)))
     origin = points.min(axis=0)
     edge, lo, hi = _edge_pieces(a, b, h)
-    piece, cells = _cell_entries(lo, hi, h, origin)
-    edge = edge[piece]
+    first = np.floor((lo - origin) / h).astype(np.int64)
+    span = np.floor((hi - origin) / h).astype(np.int64) - first + 1
     vertex_cells = np.floor((points - origin) / h).astype(np.int64)
-    size = np.maximum(vertex_cells.max(axis=0), cells.max(axis=0)) + 2
+    size = np.maximum(vertex_cells.max(axis=0), (first + span).max(axis=0)) + 2
     if int(objects.max() + 1) * int(size[0]) * int(size[1]) * int(size[2]) >= 2 ** 62:
         raise ValueError("scene too large for the cell grid")
 
     def key(obj, c):
         return ((obj * size[0] + c[:, 0] + 1) * size[1] + c[:, 1] + 1) * size[2] + c[:, 2] + 1
 
-    edge_keys = key(objects[edges[edge, 0]], cells)
-    order = np.argsort(edge_keys)
-    edge_keys, edge = edge_keys[order], edge[order].astype(np.int32)
     vertex_keys = key(objects, vertex_cells)
-    first = np.searchsorted(edge_keys, vertex_keys, "left")
-    count = np.searchsorted(edge_keys, vertex_keys, "right") - first
+    by_cell = np.argsort(vertex_keys).astype(np.int32)
+    vertex_keys = vertex_keys[by_cell]
+    edge_objects = objects[edges[:, 0]]
     box_lo, box_hi = np.minimum(a, b).astype(np.float32), np.maximum(a, b).astype(np.float32)
     points32 = points.astype(np.float32)  # exact: the points are float32 values
     ends = edges.astype(np.int32)
-    total = np.cumsum(count)
-    start = 0
-    while start < len(points):  # vertices in chunks of about `chunk` pairs
-        stop = int(np.searchsorted(total, total[start] - count[start] + chunk, "right"))
-        stop = max(stop, start + 1)
-        n = count[start:stop]
-        vertex = np.repeat(np.arange(start, stop, dtype=np.int32), n)
-        offset = np.arange(len(vertex)) - np.repeat(np.cumsum(n) - n, n)
-        e = edge[np.repeat(first[start:stop], n) + offset]
-        keep = (ends[e, 0] != vertex) & (ends[e, 1] != vertex)
-        vertex, e = vertex[keep], e[keep]
-        v = points32[vertex]
-        keep = ((v >= box_lo[e]) & (v <= box_hi[e])).all(axis=1)
-        yield vertex[keep], e[keep]
-        start = stop
+    step = max(1, chunk // 4)
+    for offset in np.ndindex(*span.max(axis=0)):
+        covers = np.flatnonzero((np.array(offset) < span).all(axis=1))
+        for part in range(0, len(covers), step):  # about `chunk` pairs at once
+            take = covers[part:part + step]
+            e = edge[take]
+            keys = key(edge_objects[e], first[take] + np.array(offset))
+            start = np.searchsorted(vertex_keys, keys, "left")
+            n = np.searchsorted(vertex_keys, keys, "right") - start
+            e = np.repeat(e, n).astype(np.int32)
+            at = np.arange(len(e)) - np.repeat(np.cumsum(n) - n, n)
+            vertex = by_cell[np.repeat(start, n) + at]
+            keep = (ends[e, 0] != vertex) & (ends[e, 1] != vertex)
+            vertex, e = vertex[keep], e[keep]
+            v = points32[vertex]
+            keep = ((v >= box_lo[e]) & (v <= box_hi[e])).all(axis=1)
+            yield vertex[keep], e[keep]
 
 
 def t_junctions(positions: np.ndarray, triangles: np.ndarray, object_ids: np.ndarray | None = None,
