@@ -5,6 +5,9 @@ triangles in the same order, count mode == emit mode == the closed forms, the ro
 The header is built into a tiny test program with the few common definitions it needs (the
 pattern contract's edge_param, factor_of, put_triangle), on the default device (PoCL here)."""
 import itertools
+import os
+import subprocess
+import sys
 from importlib import resources
 
 import numpy as np
@@ -77,7 +80,7 @@ __kernel void emit(__global const int4 *records, uint cases, __global const uint
     for (int j = 0; j < pattern_rows(f); ++j) {
         float2 uv0, uv1;
         int n = pattern_row(f, j, &uv0, &uv1);
-        row_ends[c * MAX_ROWS + j] = (float4)(uv0, uv1);
+        row_ends[c * MAX_ROWS + j] = (float4)(uv0.x, uv0.y, uv1.x, uv1.y);
         row_counts[c * MAX_ROWS + j] = n;
         for (int i = 0; i < n; ++i)
             uvs[at++] = pattern_row_point(f, j, i);
@@ -98,11 +101,11 @@ def build(context, domain):
     return cl.Program(context, source).build(options=["-I", KERNELS_DIR])
 
 
-def records_of(domain):
-    """Every case m <= 5, p_e <= m, as records of dyadic factors, and one culled record."""
+def records_of(domain, max_level=MAX_TESTED_LEVEL):
+    """Every case m <= max_level, p_e <= m, as records of dyadic factors, and one culled record."""
     edges = su.EDGES[domain]
     records = [[1 << p for p in levels] + [0] * (4 - edges)
-               for m in range(MAX_TESTED_LEVEL + 1) for levels in itertools.product(range(m + 1), repeat=edges)
+               for m in range(max_level + 1) for levels in itertools.product(range(m + 1), repeat=edges)
                if max(levels) == m]
     return np.array(records + [[0, 0, 0, 0]], np.int32)
 
@@ -111,49 +114,48 @@ def offsets(counts):
     return np.concatenate([[0], np.cumsum(counts)]).astype(np.uint32)
 
 
-@pytest.mark.parametrize("domain", ["quad", "tri"])
-def test_device_pattern_equals_mirror(context, domain):
+def run_kernels(context, domain, records, short=0):
+    """Both test kernels on records: (counts: vertices, count mode, closed form, rows; emit:
+    uvs, row_ends, row_counts, indices, emitted), the emit buffers offset by the count kernel's
+    counts.  short: triangles left out of the index buffer (the Oclgrind self-test)."""
     ctx, queue = context
     program = build(ctx, domain)
-    records = records_of(domain)
     cases = len(records)
-    mirror = [su.pattern(domain, r) for r in records]
     mf = cl.mem_flags
 
-    def buffer(array):
-        return cl.Buffer(ctx, mf.READ_WRITE | mf.COPY_HOST_PTR, hostbuf=array)
+    def run(kernel, shapes, *inputs):
+        hosts = [np.zeros(shape, dtype) for shape, dtype in shapes]
+        outs = [cl.Buffer(ctx, mf.READ_WRITE | mf.COPY_HOST_PTR, hostbuf=host) for host in hosts]
+        inputs = [cl.Buffer(ctx, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=x) for x in inputs]
+        kernel(queue, (cases,), None, inputs[0], np.uint32(cases), *inputs[1:], *outs)
+        for out, host in zip(outs, hosts):
+            cl.enqueue_copy(queue, host, out)
+        return hosts
 
-    def device(*shape, dtype=np.uint32):
-        return np.zeros(shape, dtype)
+    counts = run(cl.Kernel(program, "counts"), [(cases, np.uint32)] * 3 + [(cases, np.int32)], records)
+    vertex_offsets, triangle_offsets = offsets(counts[0]), offsets(counts[1])
+    shapes = [((int(vertex_offsets[-1]), 2), np.float32), ((cases * MAX_ROWS, 4), np.float32),
+              (cases * MAX_ROWS, np.int32), ((max(int(triangle_offsets[-1]) - short, 1), 3), np.uint32),
+              (cases, np.uint32)]
+    emit = run(cl.Kernel(program, "emit"), shapes, records, vertex_offsets, triangle_offsets)
+    return counts, emit
 
-    records_buf = buffer(records)
-    vertices, count_mode, closed_form, rows = device(cases), device(cases), device(cases), device(cases, dtype=np.int32)
-    outs = [buffer(a) for a in (vertices, count_mode, closed_form, rows)]
-    program.counts(queue, (cases,), None, records_buf, np.uint32(cases), *outs)
-    for out, host in zip(outs, (vertices, count_mode, closed_form, rows)):
-        cl.enqueue_copy(queue, host, out)
 
-    expected_vertices = [len(uv) for uv, _ in mirror]
+def check_device_pattern(context, domain, max_level=MAX_TESTED_LEVEL):
+    records = records_of(domain, max_level)
+    mirror = [su.pattern(domain, r) for r in records]
+    (vertices, count_mode, closed_form, rows), (uvs, row_ends, row_counts, indices, emitted) = \
+        run_kernels(context, domain, records)
+
     expected_triangles = [len(t) for _, t in mirror]
-    assert vertices.tolist() == expected_vertices
+    assert vertices.tolist() == [len(uv) for uv, _ in mirror]
     assert count_mode.tolist() == expected_triangles
     assert closed_form.tolist() == expected_triangles
-    closed = [0 if r[0] == 0 else su.triangle_count(domain, *su.record_levels(r, domain)) for r in records]
-    assert closed_form.tolist() == closed
+    assert closed_form.tolist() == [0 if r[0] == 0 else su.triangle_count(domain, *su.record_levels(r, domain))
+                                    for r in records]
+    assert np.array_equal(emitted, count_mode)  # emit mode == count mode
 
     vertex_offsets, triangle_offsets = offsets(vertices), offsets(count_mode)
-    uvs = device(int(vertex_offsets[-1]), 2, dtype=np.float32)
-    row_ends = device(cases * MAX_ROWS, 4, dtype=np.float32)
-    row_counts = device(cases * MAX_ROWS, dtype=np.int32)
-    indices = device(int(triangle_offsets[-1]), 3)
-    emitted = device(cases)
-    outs = [buffer(a) for a in (uvs, row_ends, row_counts, indices, emitted)]
-    program.emit(queue, (cases,), None, records_buf, np.uint32(cases), buffer(vertex_offsets),
-                 buffer(triangle_offsets), *outs)
-    for out, host in zip(outs, (uvs, row_ends, row_counts, indices, emitted)):
-        cl.enqueue_copy(queue, host, out)
-
-    assert np.array_equal(emitted, count_mode)  # emit mode == count mode
     for c, (record, (uv, triangles)) in enumerate(zip(records, mirror)):
         first, last = vertex_offsets[c], vertex_offsets[c + 1]
         assert np.array_equal(uvs[first:last].astype(np.float64), uv), record  # bit for bit
@@ -173,6 +175,11 @@ def test_device_pattern_equals_mirror(context, domain):
         assert len(uv) == ring + counts.sum(), record
         assert np.array_equal(points, uv[ring:] * n * total), record
         assert np.array_equal(ends[:, 1], np.arange(1, rows[c] + 1)), record
+
+
+@pytest.mark.parametrize("domain", ["quad", "tri"])
+def test_device_pattern_equals_mirror(context, domain):
+    check_device_pattern(context, domain)
 
 
 def test_dyadic_factor_on_device_equals_mirror(context):
@@ -195,3 +202,56 @@ __kernel void dyadic(__global const int *f, __global int *out, int max_level)
         cl.enqueue_copy(queue, out, out_buf)
         expected = su.dyadic_factors(factors.astype(np.int64), max_level)
         assert np.array_equal(out, expected), max_level
+
+
+def check_dyadic_factor(context):
+    test_dyadic_factor_on_device_equals_mirror(context)
+
+
+# --- Oclgrind: every kernel path of the header, checked (tests/test_oclgrind.py's two passes) ---
+
+OCLGRIND_PASSES = {
+    "checks": {"OCLGRIND_CHECK_API": "1", "OCLGRIND_DATA_RACES": "1", "OCLGRIND_UNIFORM_WRITES": "1"},
+    # unoptimised: the plugin stops at LLVM's freeze instruction otherwise (oclgrind_scenarios.py)
+    "uninitialized": {"OCLGRIND_UNINITIALIZED": "1", "PYOPENCL_BUILD_OPTIONS": "-O0"},
+}
+OCLGRIND_LEVEL = 3  # every case up to m = 3: all code paths, a few seconds in the simulator
+# pyopencl itself asks the device for a property Oclgrind does not know (at build and kernel
+# creation, no launch involved): that API report is not about our kernels.
+PYOPENCL_QUERY = "Oclgrind - OpenCL runtime error detected\n\tFunction: clGetDeviceInfo\n\tError:    CL_INVALID_VALUE\n"
+
+
+def oclgrind_reports(pass_name, *args):
+    from cltess.device import list_devices
+    if not any(info.matches("oclgrind") for info in list_devices()):
+        pytest.skip("no Oclgrind platform (the test extra installs it)")
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OCLGRIND_", "PYOPENCL_BUILD"))}
+    env.update(OCLGRIND_PASSES[pass_name], CLTESS_DEVICE="oclgrind", OCLGRIND_MAX_ERRORS="1000000")
+    process = subprocess.run([sys.executable, __file__, *args], capture_output=True, text=True, env=env,
+                             timeout=300)
+    blocks = [b.strip("\n") + "\n" for b in process.stderr.split("\n\n") if b.strip()]
+    return process, [b for b in blocks if not b.startswith(PYOPENCL_QUERY) and b.strip() != "done"]
+
+
+@pytest.mark.parametrize("pass_name", OCLGRIND_PASSES)
+def test_oclgrind_clean(pass_name):
+    process, reports = oclgrind_reports(pass_name, str(OCLGRIND_LEVEL))
+    assert process.returncode == 0, process.stderr[-3000:]
+    assert "done" in process.stderr and reports == [], "\n".join(reports[:5])
+
+
+def test_oclgrind_sees_a_short_index_buffer():
+    """The harness can fail: one triangle too few in the index buffer is an invalid write."""
+    _, reports = oclgrind_reports("checks", "1", "--short")
+    assert any(r.startswith("Invalid write") and "Kernel: emit" in r for r in reports), reports
+
+
+if __name__ == "__main__":  # the Oclgrind runner: python this_file.py MAX_LEVEL [--short]
+    device_context = make_queue(pick_device())
+    if "--short" in sys.argv:
+        run_kernels(device_context, "quad", records_of("quad", int(sys.argv[1])), short=1)
+    else:
+        for name in ("quad", "tri"):
+            check_device_pattern(device_context, name, int(sys.argv[1]))
+        check_dyadic_factor(device_context)
+    print("done", file=sys.stderr)
