@@ -501,7 +501,9 @@ def dask_client(scheduler: str | None = None, workers: int | None = None, timeou
             yield client
         return
     # A task that kills its worker (a crashing driver) fails its input after two tries, not four.
-    with dask.config.set({"distributed.scheduler.allowed-failures": 1}):
+    with dask.config.set({"distributed.scheduler.allowed-failures": 1}), warnings.catch_warnings():
+        # Its HTTP server (no dashboard) takes another port where 8787 is taken: nothing to say.
+        warnings.filterwarnings("ignore", message="Port .* is already in use")
         cluster = LocalCluster(n_workers=workers or default_workers(), threads_per_worker=1, processes=True,
                                dashboard_address=None, silence_logs=logging.ERROR)
     try:
