@@ -201,9 +201,15 @@ def test_cli_batch_reports_the_failed_input_and_exits_3(client, capsys, inputs, 
 
 
 def test_cli_batch_on_its_own_local_cluster(capsys, inputs, tmp_path):
+    before = {child.pid for child in psutil.Process().children(recursive=True)}
     code, stdout, stderr = run(capsys, "batch", inputs / "tea*.bez", "--eps", EPS, "-o", tmp_path / "out",
                                "--workers", "2", "--format", "obj")
     assert code == 0, stderr
+    left = [" ".join(c.cmdline()) for c in psutil.Process().children(recursive=True)
+            if c.pid not in before and c.is_running() and c.status() != psutil.STATUS_ZOMBIE]
+    # multiprocessing's resource tracker stays for the life of this process, as it should
+    left = [cmdline for cmdline in left if "resource_tracker" not in cmdline]
+    assert not left, f"the local cluster left processes behind: {left}"
     assert "3 done, 0 up to date, 0 failed" in stdout
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == [
         "manifest.json", "teacup.bez.obj", "teapot.bez.obj", "teaspoon.bez.obj"]
