@@ -67,6 +67,7 @@ class BatchOptions:
     format: str = "ply"
     device: str | None = None
     max_memory: int | None = None
+    check_bound: bool = False  # measure each output's worst error / tolerance (cltess.bound)
 
     def __post_init__(self):
         if (self.eps is None) == (self.pixels is None):
@@ -177,7 +178,7 @@ def _unchanged(prints: list[dict]) -> bool:
     return True
 
 
-def up_to_date(row: dict | None, path: Path, output: Path, key: dict) -> bool:
+def up_to_date(row: dict | None, path: Path, output: Path, key: dict, check_bound: bool = False) -> bool:
     """Whether a previous manifest row still describes ``output``: it succeeded with the same
     output key, its input files are unchanged and the output has the size it recorded."""
     if not row or row.get("status") not in ("done", "skipped") or row.get("options") != key:
@@ -187,6 +188,8 @@ def up_to_date(row: dict | None, path: Path, output: Path, key: dict) -> bool:
             return False
     except OSError:
         return False
+    if check_bound and row.get("worst_bound_ratio") is None and output.suffix != ".obj":
+        return False  # asked for now, not measured then
     prints = row.get("fingerprint") or []
     return bool(prints) and prints[0]["file"] == str(path) and _unchanged(prints)
 
@@ -234,7 +237,7 @@ def as_table(rows: list[dict]):
 def _row(path: Path, output: Path, key: dict, **fields) -> dict:
     row = {"input": str(path), "output": str(output), "status": "failed", "error": None,
            "patches": None, "culled": None, "saturated": None, "vertices": None, "triangles": None,
-           "output_bytes": None, "parts": None, "seconds": None,
+           "output_bytes": None, "worst_bound_ratio": None, "parts": None, "seconds": None,
            **{f"{stage}_ms": None for stage in STAGE_COLUMNS}, "worker": None, "device": None,
            "options": key, "fingerprint": []}
     row.update(fields)
@@ -283,8 +286,12 @@ def _worker_tessellator(device_name: str | None, slots: dict):
 
 def device_slots(client) -> dict:
     """{worker address: its rank among the workers on its host}, for ``worker_device``."""
+    try:
+        workers = client.scheduler_info(n_workers=-1)["workers"]  # all of them (newer Dask lists 5 by default)
+    except TypeError:  # a Dask before the n_workers argument, which lists all
+        workers = client.scheduler_info()["workers"]
     by_host: dict = {}
-    for address, info in sorted(client.scheduler_info(n_workers=-1)["workers"].items()):
+    for address, info in sorted(workers.items()):
         by_host.setdefault(info.get("host", address.rsplit(":", 1)[0]), []).append(address)
     return {address: rank for addresses in by_host.values() for rank, address in enumerate(addresses)}
 
@@ -314,10 +321,51 @@ def tessellate_file_task(path: str, output: str, options: BatchOptions, slots: d
         result = tessellate_to_file(tessellator, scene, output, max_memory_bytes=options.max_memory, **kwargs)
         row.update(_counts(result.stats), status="done", output_bytes=output.stat().st_size,
                    parts=result.batches, **{f"{s}_ms": result.stage_ms.get(s) for s in STAGE_COLUMNS})
+        if options.check_bound:
+            row["worst_bound_ratio"] = measure_output(scene, output, options)
     except Exception as error:  # noqa: BLE001 - any failure is this input's own, reported in its row
         row["error"] = _describe(error)
     row["seconds"] = time.perf_counter() - started
     return row
+
+
+BOUND_TRIANGLES = 20_000  # --check-bound samples every k-th triangle, about this many in all
+
+
+def read_output(output: Path):
+    """The mesh of a .ply (as cltess writes it) or .npz output, for measuring; None for .obj,
+    which has no patch ids."""
+    from .export import PLY_FACE_DTYPE, PLY_VERTEX_DTYPE, load_npz
+    from .tessellation import Tessellation
+
+    if output.suffix == ".npz":
+        return load_npz(output)
+    if output.suffix != ".ply":
+        return None
+    counts = {}
+    with open(output, "rb") as handle:
+        for line in iter(handle.readline, b""):
+            if line.startswith(b"element "):
+                counts[line.split()[1]] = int(line.split()[2])
+            if line == b"end_header\n":
+                break
+        vertices = np.fromfile(handle, PLY_VERTEX_DTYPE, counts[b"vertex"])
+        faces = np.fromfile(handle, PLY_FACE_DTYPE, counts[b"face"])
+    field = lambda *names: np.stack([vertices[n] for n in names], axis=1)  # noqa: E731
+    return Tessellation(positions=field("x", "y", "z"), normals=field("nx", "ny", "nz"), uv=field("u", "v"),
+                        patch_ids=vertices["patch"], object_ids=vertices["object"],
+                        triangles=faces["vertex_indices"], factors=np.zeros((0, 4), np.int32))
+
+
+def measure_output(scene, output: Path, options: BatchOptions) -> float | None:
+    """The worst bound ratio of a written output (``cltess.bound``, sampled), None for OBJ."""
+    from .bound import worst_bound_ratio
+
+    mesh = read_output(output)
+    if mesh is None:
+        return None
+    return worst_bound_ratio(scene, mesh, options.eps, options.pixels, options.sharp_edges,
+                             max_triangles=BOUND_TRIANGLES)
 
 
 def _describe(error: BaseException) -> str:
@@ -585,12 +633,14 @@ def tessellate_files(inputs, outdir, options: BatchOptions | None = None, *, cli
     jobs = [(path, outdir / f"{name}.{options.format}") for path, name in expand_inputs(inputs)]
     if split is not None and options.format != "ply":
         raise ValueError(f"a split scene is joined as PLY; --format {options.format} cannot be split")
+    if split is not None and options.check_bound:
+        raise ValueError("--check-bound measures whole outputs on one worker; it cannot be used with --split")
     outdir.mkdir(parents=True, exist_ok=True)
     key = options.output_key()
     previous = {row.get("input"): row for row in read_manifest(outdir)["rows"]}
     rows: dict[Path, dict] = {}
     for path, output in jobs:
-        if up_to_date(previous.get(str(path)), path, output, key):
+        if up_to_date(previous.get(str(path)), path, output, key, options.check_bound):
             rows[path] = dict(previous[str(path)], status="skipped")
     todo = [(path, output) for path, output in jobs if path not in rows]
     bar = progress if isinstance(progress, Progress) else Progress(enabled=bool(progress))

@@ -103,6 +103,45 @@ def test_rerun_skips_what_is_up_to_date(client, inputs, tmp_path):
     assert set(statuses(eps=EPS / 2).values()) == {"done", "failed"}  # new options: all redone
 
 
+def test_check_bound_measures_each_output_as_the_tests_do(client, inputs, tmp_path, tessellator):
+    """--check-bound reads each output back and measures it (cltess.bound), as support.bound_ratio
+    measures the in-memory mesh; OBJ keeps no patch ids, so its ratio stays unknown."""
+    from support import bound_ratio
+
+    files = [inputs / "teapot.bez", inputs / "sphere.bpt"]
+    rows = tessellate_files(files, tmp_path / "out", eps=EPS, client=client, check_bound=True)
+    for path, row in zip(files, rows):
+        scene = load_scene(path)
+        expected = bound_ratio(np.asarray(scene.patches, float), tessellator.tessellate(scene, eps=EPS), EPS, order=4)
+        assert row["worst_bound_ratio"] == pytest.approx(expected, rel=1e-12)
+        assert 0.1 < row["worst_bound_ratio"] <= 1
+    rows = tessellate_files(files[:1], tmp_path / "out", eps=EPS, client=client, check_bound=True)
+    assert rows[0]["status"] == "skipped" and rows[0]["worst_bound_ratio"] is not None
+    [npz] = tessellate_files(files[:1], tmp_path / "npz", eps=EPS, client=client, check_bound=True, format="npz")
+    assert npz["worst_bound_ratio"] == rows[0]["worst_bound_ratio"]
+    [obj] = tessellate_files(files[:1], tmp_path / "obj", eps=EPS, client=client, check_bound=True, format="obj")
+    assert obj["status"] == "done" and obj["worst_bound_ratio"] is None
+
+
+def test_bound_of_pn_triangles_and_of_a_mixed_scene(tessellator):
+    from support import bound_ratio, genus2
+
+    from cltess import Scene, reference
+    from cltess.bound import worst_bound_ratio
+    from cltess.pipeline import PN
+
+    mesh = Scene.from_trimesh(genus2(resolution=1))
+    tess = tessellator.tessellate(mesh, eps=2e-3)
+    controls = reference.pn_control_points(np.asarray(PN.prepare(mesh).source, float))
+    expected = bound_ratio(controls, tess, 2e-3, order=4, surface=reference.pn_surface_points)
+    assert worst_bound_ratio(mesh, tess, eps=2e-3) == pytest.approx(expected, rel=1e-12)
+    assert 0.1 < expected <= 1
+    mixed = load_scene(SCENES / "tea_table.json")
+    mixed = Scene(mixed.patches, mixed.object_ids, meshes=mesh.meshes, name="mixed")
+    tess = tessellator.tessellate(mixed, eps=2e-3, max_factor=256)
+    assert 0.1 < worst_bound_ratio(mixed, tess, eps=2e-3) <= 1
+
+
 def test_split_scene_is_byte_identical_to_one_process(client, tmp_path, tessellator):
     row = tessellate_split(SCENES / "teapot.bez", tmp_path / "teapot.ply", client=client, parts=7, eps=1e-3,
                            max_factor=256)
@@ -221,6 +260,7 @@ def test_cli_batch_on_its_own_local_cluster(capsys, inputs, tmp_path):
     (["{teapot}", "--eps", "0.01", "--split", "2", "--format", "obj"], "cannot be split"),
     (["{teapot}", "--eps", "0.01", "--scheduler", "tcp://127.0.0.1:1", "--workers", "2"], "--workers"),
     (["{teapot}", "--eps", "0"], "must be a finite number > 0"),
+    (["{teapot}", "--eps", "0.01", "--split", "2", "--check-bound"], "cannot be used with --split"),
     (["{teapot}", "--eps", "0.01", "--pixels", "1"], "not allowed with argument"),
 ])
 def test_cli_batch_bad_arguments_exit_2_before_any_work(capsys, tmp_path, monkeypatch, arguments, fragment):
