@@ -39,13 +39,13 @@ from pathlib import Path
 import numpy as np
 
 from .export import SUPPORTED_EXTENSIONS, atomic_write, ply_face_records, ply_header, ply_vertex_records
-from .formats import _READERS as SCENE_READERS
+from .meshes import MESH_EXTENSIONS
 from .reference import DEFAULT_MAX_FACTOR
 
 MANIFEST_NAME = "manifest.json"
 MANIFEST_VERSION = 1
 PARTS_PER_WORKER = 4  # ranges per worker in a split run: some slack for uneven ranges
-SCENE_EXTENSIONS = tuple(SCENE_READERS)
+SCENE_EXTENSIONS = (".bpt", ".bez", ".json") + MESH_EXTENSIONS  # what a folder input takes (formats.load_scene)
 STAGE_COLUMNS = ("factors", "crack_free", "counts", "vertices", "indices")
 CONNECT_TIMEOUT_S = 30
 
@@ -96,15 +96,18 @@ def _version() -> str:
         return "unknown"
 
 
-def expand_inputs(patterns) -> list[tuple[Path, str]]:
+def expand_inputs(patterns, exclude=None) -> list[tuple[Path, str]]:
     """(input path, output name) for every file that ``patterns`` name, in order, once each.
 
     A pattern is a file (taken whatever its extension: a bad one fails its own row), a folder
     (its scene files, recursively, sorted) or a glob (``*``, ``?``, ``[``, ``**``).  The output
     name keeps the input's name and its path under the folder it was found in, and appends the
-    format: ``scenes/teapot.bez`` -> ``teapot.bez.ply``.  Raises ValueError for a pattern that
-    names nothing, and for two inputs that would write the same output.
+    format: ``scenes/teapot.bez`` -> ``teapot.bez.ply``.  Files under the folder ``exclude``
+    (the output folder: its .ply files are meshes too) are left out of folders and globs.
+    Raises ValueError for a pattern that names nothing, and for two inputs that would write
+    the same output.
     """
+    skip = Path(exclude).resolve() if exclude is not None else None
     found: dict[Path, str] = {}
     for pattern in map(str, patterns):
         path = Path(pattern)
@@ -118,6 +121,8 @@ def expand_inputs(patterns) -> list[tuple[Path, str]]:
                      if Path(p).is_file()]
         else:
             raise ValueError(f"{pattern}: no such file or folder")
+        if skip is not None and not path.is_file():
+            names = [(file, name) for file, name in names if not file.resolve().is_relative_to(skip)]
         if not names:
             raise ValueError(f"{pattern}: names no scene file ({', '.join(SCENE_EXTENSIONS)})")
         for file, name in names:
@@ -630,7 +635,7 @@ def tessellate_files(inputs, outdir, options: BatchOptions | None = None, *, cli
     outdir = Path(outdir)
     if outdir.exists() and not outdir.is_dir():
         raise ValueError(f"{outdir}: not a folder")
-    jobs = [(path, outdir / f"{name}.{options.format}") for path, name in expand_inputs(inputs)]
+    jobs = [(path, outdir / f"{name}.{options.format}") for path, name in expand_inputs(inputs, exclude=outdir)]
     if split is not None and options.format != "ply":
         raise ValueError(f"a split scene is joined as PLY; --format {options.format} cannot be split")
     if split is not None and options.check_bound:

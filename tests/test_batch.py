@@ -214,6 +214,10 @@ def test_inputs_expand_folders_and_globs_and_refuse_clashes(tmp_path, inputs):
         expand_inputs([tmp_path / "missing.bez"])
     with pytest.raises(ValueError, match="names no scene file"):
         expand_inputs([str(tmp_path / "*.nothing")])
+    (inputs / "out").mkdir()
+    (inputs / "out" / "teapot.bez.ply").write_bytes(b"ply\n")  # an earlier run's output, a mesh file
+    assert len(expand_inputs([inputs], exclude=inputs / "out")) == 7
+    assert len(expand_inputs([inputs])) == 8
 
 
 # --------------------------------------------------------------------------- the command line
