@@ -552,7 +552,6 @@ class Plan:
             first = last
         return ranges
 
-
     def to_host(self) -> "HostPlan":
         """Read the plan back to the host (picklable), for ``Tessellator.upload_plan`` on
         another device or process (issue 17)."""
