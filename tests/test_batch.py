@@ -243,6 +243,17 @@ def test_cli_batch_reports_the_failed_input_and_exits_3(client, capsys, inputs, 
     assert code == 0 and stdout == ""
 
 
+def test_cli_batch_split_writes_what_tessellate_writes(client, capsys, tmp_path):
+    code, stdout, stderr = run(capsys, "batch", SCENES / "teacup.bez", "--eps", 1e-3, "--split", 3, "-o",
+                               tmp_path / "out", "--scheduler", client.scheduler.address)
+    assert code == 0, stderr
+    assert "1 done, 0 up to date, 0 failed" in stdout
+    code, _, stderr = run(capsys, "tessellate", SCENES / "teacup.bez", "--eps", 1e-3, "-o", tmp_path / "one.ply", "-q")
+    assert code == 0, stderr
+    assert (tmp_path / "out" / "teacup.bez.ply").read_bytes() == (tmp_path / "one.ply").read_bytes()
+    assert read_manifest(tmp_path / "out")["rows"][0]["parts"] == 3
+
+
 def test_cli_batch_on_its_own_local_cluster(capsys, inputs, tmp_path):
     before = {child.pid for child in psutil.Process().children(recursive=True)}
     code, stdout, stderr = run(capsys, "batch", inputs / "tea*.bez", "--eps", EPS, "-o", tmp_path / "out",
