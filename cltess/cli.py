@@ -4,9 +4,12 @@
     cltess tessellate SCENE (--eps E | --pixels PX) [--no-fd] [--max-factor N] [--max-memory SIZE]
                       [--sharp-edges {straight,average,keep}] [--device NAME] [--quiet] -o OUT
     cltess bench [SCENES...] [--device NAME] [--repeat N] [--warmup N] [--no-baseline] [--json OUT]
+    cltess batch INPUTS... (--eps E | --pixels PX) -o OUTDIR [--format {ply,obj,npz}] [--split N]
+                 [--scheduler ADDRESS] [--workers N] [tessellate's options]
 
 Exit codes: 0 success, 1 OpenCL / device failure, 2 usage or input error, 130 interrupted
-(Ctrl-C), 143 and 129 for SIGTERM and SIGHUP, which are handled like Ctrl-C.
+(Ctrl-C), 143 and 129 for SIGTERM and SIGHUP, which are handled like Ctrl-C; batch: 3 when
+some inputs failed (each failure is in its manifest row).
 Expected errors print ``cltess: error: <message>`` on stderr, without a traceback, and leave
 no output file behind (exports are atomic).
 """
@@ -144,6 +147,43 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("-o", "--output", required=True, metavar="OUT",
                      help=f"output mesh: {', '.join(SUPPORTED_EXTENSIONS)}")
     run.add_argument("-q", "--quiet", action="store_true", help="print nothing on success (warnings still go to stderr)")
+
+    batch = commands.add_parser(
+        "batch", help="tessellate many scenes (or one huge scene) on Dask workers", parents=[verbose],
+        description="Tessellate every input (files, folders, globs) with the same options on a Dask "
+                    "cluster, one output per input in OUTDIR plus OUTDIR/manifest.json (one row per "
+                    "input: status, counts, stage times, the error if it failed). A rerun skips the "
+                    "inputs whose output is up to date. Needs the 'dist' extra: pip install 'cltess[dist]'.",
+    )
+    batch.add_argument("inputs", nargs="+", metavar="INPUTS", help="scene files, folders or globs")
+    batch_tolerance = batch.add_mutually_exclusive_group(required=True)
+    batch_tolerance.add_argument("--eps", type=_positive_float, metavar="E", help="as for tessellate")
+    batch_tolerance.add_argument("--pixels", type=_positive_float, metavar="PX", help="as for tessellate")
+    batch.add_argument("--no-fd", action="store_true", help="as for tessellate")
+    batch.add_argument("--max-factor", type=_factor, default=DEFAULT_MAX_FACTOR, metavar="N",
+                       help=f"as for tessellate (default {DEFAULT_MAX_FACTOR})")
+    batch.add_argument("--sharp-edges", choices=("straight", "average", "keep"), default="straight",
+                       help="as for tessellate")
+    batch.add_argument("--device", metavar="NAME",
+                       help="OpenCL device of every worker (default: one GPU per worker where there are "
+                            "several, else the device tessellate would use)")
+    batch.add_argument("--max-memory", type=_memory_size, metavar="SIZE",
+                       help="output a worker may hold at once (default: half its device's memory)")
+    batch.add_argument("--format", choices=[e[1:] for e in SUPPORTED_EXTENSIONS], default="ply",
+                       help="output format (default ply): OUTDIR/NAME.EXT for an input NAME.EXT")
+    batch.add_argument("--split", type=_factor, metavar="N",
+                       help="tessellate each input across all workers in about N patch ranges, joined into "
+                            "one PLY (for a scene too large for one worker)")
+    batch.add_argument("--scheduler", metavar="ADDRESS",
+                       help="Dask scheduler to run on (e.g. tcp://host:8786); default: a local cluster")
+    batch.add_argument("--workers", type=_factor, metavar="N",
+                       help="worker processes of the local cluster (default: one per GPU where there are "
+                            "several, else one per CPU core)")
+    batch.add_argument("--check-bound", action="store_true",
+                       help="measure each output's worst distance to the surface / tolerance into the "
+                            "manifest (NumPy, on a sample of its triangles; .ply and .npz, not with --split)")
+    batch.add_argument("-o", "--output", required=True, metavar="OUTDIR", help="output folder")
+    batch.add_argument("-q", "--quiet", action="store_true", help="no progress bar or summary on success")
 
     bench = commands.add_parser(
         "bench", help="benchmark suite: the CudaTess paper's Tables 1 and 2 on one device",
@@ -303,7 +343,52 @@ def cmd_bench(args) -> int:
     return EXIT_OK
 
 
-_COMMANDS = {"devices": cmd_devices, "tessellate": cmd_tessellate, "bench": cmd_bench}
+EXIT_SOME_FAILED = 3  # batch: some inputs failed
+
+
+def cmd_batch(args) -> int:
+    """Tessellate many inputs on a Dask cluster (cltess.batch); exit 3 if any input failed."""
+    try:
+        import distributed  # noqa: F401
+    except ImportError:
+        raise UsageError("cltess batch needs Dask: pip install 'cltess[dist]'") from None
+    from cltess.batch import BatchOptions, Progress, summarize, tessellate_files
+    from cltess.device import DeviceError
+
+    if args.scheduler and args.workers:
+        raise UsageError("--workers sizes the local cluster; it cannot be used with --scheduler")
+    options = BatchOptions(eps=args.eps, pixels=args.pixels, max_factor=args.max_factor,
+                           forward_differencing=not args.no_fd, sharp_edges=args.sharp_edges,
+                           format=args.format, device=args.device, max_memory=args.max_memory,
+                           check_bound=args.check_bound)
+    try:
+        rows = tessellate_files(args.inputs, args.output, options, scheduler=args.scheduler,
+                                workers=args.workers, split=args.split, progress=Progress(enabled=not args.quiet))
+    except (OSError, TimeoutError) as error:
+        if args.scheduler and not getattr(error, "filename", None):
+            raise DeviceError(f"cannot reach the Dask scheduler at {args.scheduler}: {error}") from None
+        raise
+    manifest = Path(args.output) / "manifest.json"
+    counts = summarize(rows)
+    saturated = sum(1 for row in rows if row.get("saturated"))
+    if saturated:
+        print(f"{PROG}: warning: {saturated} input{'s' if saturated > 1 else ''} have patches that reach "
+              f"--max-factor {args.max_factor} and do not meet the error bound; raise --max-factor", file=sys.stderr)
+    if not args.quiet:
+        print(f"{counts['done']} done, {counts['skipped']} up to date, {counts['failed']} failed; "
+              f"manifest {manifest}")
+    failed = [row for row in rows if row["status"] == "failed"]
+    if failed:
+        shown = "".join(f"\n  {row['error']}" if row["input"] in str(row["error"])
+                        else f"\n  {row['input']}: {row['error']}" for row in failed[:10])
+        more = f"\n  ... and {len(failed) - 10} more" if len(failed) > 10 else ""
+        print(f"{PROG}: error: {len(failed)} of {len(rows)} inputs failed (every row is in {manifest}):"
+              f"{shown}{more}", file=sys.stderr)
+        return EXIT_SOME_FAILED
+    return EXIT_OK
+
+
+_COMMANDS = {"devices": cmd_devices, "tessellate": cmd_tessellate, "bench": cmd_bench, "batch": cmd_batch}
 
 
 # --------------------------------------------------------------------------- entry point

@@ -248,6 +248,46 @@ class _StreamingWriter:
 # --------------------------------------------------------------------------- PLY
 
 
+def ply_header(num_vertices: int, num_faces: int) -> bytes:
+    """The header of a cltess PLY file with these totals."""
+    lines = [
+        "ply",
+        "format binary_little_endian 1.0",
+        "comment written by cltess",
+        f"element vertex {num_vertices}",
+        *(f"property float {name}" for name in ("x", "y", "z", "nx", "ny", "nz", "u", "v")),
+        "property int patch",
+        "property int object",
+        f"element face {num_faces}",
+        "property list uchar uint vertex_indices",
+        "end_header",
+    ]
+    return ("\n".join(lines) + "\n").encode("ascii")
+
+
+def ply_vertex_records(block) -> np.ndarray:
+    """The PLY vertex records (PLY_VERTEX_DTYPE) of a block with positions, normals, uv,
+    patch_ids, object_ids."""
+    arrays = _vertex_arrays(block)
+    records = np.empty(len(arrays.positions), PLY_VERTEX_DTYPE)
+    for column, name in enumerate("xyz"):
+        records[name] = arrays.positions[:, column]
+    for column, name in enumerate(("nx", "ny", "nz")):
+        records[name] = arrays.normals[:, column]
+    records["u"], records["v"] = arrays.uv[:, 0], arrays.uv[:, 1]
+    records["patch"], records["object"] = arrays.patch_ids, arrays.object_ids
+    return records
+
+
+def ply_face_records(triangles) -> np.ndarray:
+    """The PLY face records (PLY_FACE_DTYPE) of (k, 3) vertex indices."""
+    faces = np.ascontiguousarray(triangles, dtype=np.uint32)
+    records = np.empty(len(faces), PLY_FACE_DTYPE)
+    records["count"] = 3
+    records["vertex_indices"] = faces
+    return records
+
+
 class PlyWriter(_StreamingWriter):
     """Binary little-endian PLY, written in blocks.
 
@@ -258,42 +298,18 @@ class PlyWriter(_StreamingWriter):
     """
 
     def header(self) -> bytes:
-        lines = [
-            "ply",
-            "format binary_little_endian 1.0",
-            "comment written by cltess",
-            f"element vertex {self.num_vertices}",
-            *(f"property float {name}" for name in ("x", "y", "z", "nx", "ny", "nz", "u", "v")),
-            "property int patch",
-            "property int object",
-            f"element face {self.num_faces}",
-            "property list uchar uint vertex_indices",
-            "end_header",
-        ]
-        return ("\n".join(lines) + "\n").encode("ascii")
+        return ply_header(self.num_vertices, self.num_faces)
 
     def _write_header(self) -> None:
         self._file.write(self.header())
 
     def write_vertices(self, block) -> None:
         """Append vertices: ``block`` has positions (k,3), normals (k,3), uv (k,2), patch_ids, object_ids (k,)."""
-        arrays = self._take_vertices(block)
-        records = np.empty(len(arrays.positions), PLY_VERTEX_DTYPE)
-        for column, name in enumerate("xyz"):
-            records[name] = arrays.positions[:, column]
-        for column, name in enumerate(("nx", "ny", "nz")):
-            records[name] = arrays.normals[:, column]
-        records["u"], records["v"] = arrays.uv[:, 0], arrays.uv[:, 1]
-        records["patch"], records["object"] = arrays.patch_ids, arrays.object_ids
-        self._file.write(records.view(np.uint8))
+        self._file.write(ply_vertex_records(self._take_vertices(block)).view(np.uint8))
 
     def write_faces(self, triangles) -> None:
         """Append faces: (k, 3) global, 0-based vertex indices."""
-        faces = self._take_faces(triangles)
-        records = np.empty(len(faces), PLY_FACE_DTYPE)
-        records["count"] = 3
-        records["vertex_indices"] = faces
-        self._put_faces(records.tobytes())
+        self._put_faces(ply_face_records(self._take_faces(triangles)).tobytes())
 
 
 # --------------------------------------------------------------------------- OBJ

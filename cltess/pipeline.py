@@ -352,6 +352,29 @@ class Tessellator:
         return Tessellation(triangles=triangles.get(), factors=plan.host_factors()[first:last],
                             stage_ms=stage_ms, stats=stats, **{k: a.get() for k, a in vertices.items()})
 
+    # --- stages 4-5 from factors made elsewhere (issue 17, cltess/batch.py) ---------------------
+
+    def upload_plan(self, host: "HostPlan", first: int = 0, last: int | None = None) -> "Plan":
+        """A Plan on this device from a plan read back on another (``Plan.to_host``), so that
+        ``emit(plan, a, b)`` runs stages 4-5 for any ``first <= a < b <= last`` without running
+        stages 1-3 again.  Only the controls of patches ``first .. last-1`` are uploaded (the
+        stage-4 kernels read patch p's at ``p - patch_base``, so a part may start mid-kind);
+        factors, offsets and object ids are uploaded whole (36 bytes per patch)."""
+        last = host.num_patches if last is None else last
+        parts = []
+        for (name, base, count), controls in zip(host.kinds, host.controls):
+            lo, hi = max(first, base), min(last, base + count)
+            if lo < hi:
+                data = {"controls": cl_array.to_device(self.queue, controls[lo - base:hi - base])}
+                parts.append(PlanPart(_kind(name), lo, hi - lo, data))
+        arrays = {name: cl_array.to_device(self.queue, getattr(host, name))
+                  for name in ("objects", "factors", "vertex_offsets", "index_offsets")}
+        return Plan(host.name, host.num_patches, parts, num_vertices=host.num_vertices,
+                    num_indices=host.num_indices, stats=dict(host.stats), events={},
+                    started=time.perf_counter(), _host={name: getattr(host, name) for name in
+                                                        ("factors", "vertex_offsets", "index_offsets")},
+                    **arrays)
+
     # --- the stages: device arrays in, device arrays and their events out ----------------------
 
     def stage_factors(self, patches, eps, pixels, camera, max_factor):
@@ -527,6 +550,37 @@ class Plan:
             ranges.append((first, last))
             first = last
         return ranges
+
+    def to_host(self) -> "HostPlan":
+        """Read the plan back to the host (picklable), for ``Tessellator.upload_plan`` on
+        another device or process (issue 17)."""
+        return HostPlan(self.name, self.num_patches, [(p.kind.name, p.base, p.count) for p in self.parts],
+                        [p.data["controls"].get() for p in self.parts], self.objects.get(),
+                        self.host_factors(), self._offsets("vertex_offsets"), self._offsets("index_offsets"),
+                        self.num_vertices, self.num_indices, dict(self.stats))
+
+
+@dataclass
+class HostPlan:
+    """A Plan on the host: stages 1-3 done, what stages 4-5 need for any patch range.
+
+    kinds: (kind name, base, count) per part; controls: each part's stage-4 input,
+    (count, 16, 4) float32 (the Bézier patches, or the PN control points stage 1 made);
+    objects (P,) int32; factors (P, 4) int32, final (crack-free); vertex_offsets and
+    index_offsets (P+1,) uint64 with the totals last; stats as Plan.stats.
+    """
+
+    name: str
+    num_patches: int
+    kinds: list
+    controls: list
+    objects: np.ndarray
+    factors: np.ndarray
+    vertex_offsets: np.ndarray
+    index_offsets: np.ndarray
+    num_vertices: int
+    num_indices: int
+    stats: dict
 
 
 def _check_tolerance(scene: Scene, eps, pixels, max_factor) -> None:

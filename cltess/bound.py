@@ -1,0 +1,63 @@
+"""The error bound, measured: the worst |surface(u,v) - mesh(u,v)| / tolerance of a mesh.
+
+README "The error bound": the factors make the distance from the surface to the mesh, at the
+same (u, v), at most the patch's tolerance.  This samples every (or every k-th) output triangle
+at barycentric points of order ``order`` (edges included), interpolates the triangle's vertex
+positions and (u, v), and evaluates the surface there in float64 with the NumPy reference
+(``reference.surface_points`` for Bézier patches, ``reference.pn_surface_points`` for PN
+triangles).  A ratio above 1 means the bound is missed (e.g. saturated patches).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from . import reference
+
+SAMPLES_PER_CHUNK = 100_000  # bounds the memory of one evaluation (a (n, 4, 4, 4) gather)
+
+
+def worst_bound_ratio(scene, mesh, eps: float | None = None, pixels: float | None = None,
+                      sharp_edges: str = "straight", order: int = 4, max_triangles: int | None = None) -> float:
+    """The worst ratio over samples inside the triangles of ``mesh`` (anything with positions,
+    uv, patch_ids and triangles, e.g. a Tessellation) made from ``scene`` with the tolerance
+    ``eps`` or ``pixels`` (per patch, ``reference.patch_tolerances``).  ``max_triangles``: sample
+    only every k-th triangle so that at most about this many are measured.  0.0 for no triangles.
+    """
+    from .pipeline import PN
+
+    surfaces, tolerances = [], []
+    if scene.num_bezier:
+        patches = np.asarray(scene.patches, float)
+        surfaces.append((0, lambda ids, u, v: reference.surface_points(patches, ids, u, v)))
+        tolerances.append(reference.patch_tolerances(patches, eps, pixels, scene.camera)[0])
+    if scene.num_triangles:
+        source = scene.prepared((PN.name, sharp_edges), lambda: PN.prepare(scene, sharp_edges)).source
+        controls = reference.pn_control_points(np.asarray(source, float))
+        base = scene.num_bezier
+        surfaces.append((base, lambda ids, u, v: reference.pn_surface_points(controls, ids - base, u, v)))
+        tolerances.append(reference.pn_tolerances(controls, eps, pixels, scene.camera)[0])
+    tolerance = np.concatenate(tolerances)
+    triangles = np.asarray(mesh.triangles, np.int64)
+    if max_triangles and len(triangles) > max_triangles:
+        triangles = triangles[::-(-len(triangles) // max_triangles)]
+    ij = [(i, j) for i in range(order + 1) for j in range(order + 1 - i)]
+    bary = np.array([(i, j, order - i - j) for i, j in ij], float) / order  # (S, 3)
+    positions, uv = np.asarray(mesh.positions, float), np.asarray(mesh.uv, float)
+    patch_ids = np.asarray(mesh.patch_ids, np.int64)
+    worst = 0.0
+    step = max(1, SAMPLES_PER_CHUNK // len(bary))
+    for start in range(0, len(triangles), step):
+        chunk = triangles[start:start + step]
+        ids = np.repeat(patch_ids[chunk[:, 0]], len(bary))
+        points = np.einsum("sk,tkc->tsc", bary, positions[chunk]).reshape(-1, 3)
+        params = np.einsum("sk,tkc->tsc", bary, uv[chunk]).reshape(-1, 2)
+        exact = np.empty_like(points)
+        for number, (base, surface) in enumerate(surfaces):
+            end = surfaces[number + 1][0] if number + 1 < len(surfaces) else len(tolerance)
+            mine = (ids >= base) & (ids < end)
+            exact[mine] = surface(ids[mine], params[mine, 0], params[mine, 1])
+        worst = max(worst, float((np.linalg.norm(exact - points, axis=1) / tolerance[ids]).max()))
+    return worst
+
+
+__all__ = ["worst_bound_ratio"]
