@@ -79,44 +79,94 @@ def zs_factors(patches: np.ndarray, eps: np.ndarray, culled: np.ndarray | None =
 def zs_inverse_steps(patch: np.ndarray, eps: float) -> tuple[float, float]:
     """(1/du, 1/dv) maximising du*dv under the error bound, for one (4, 4, 4) patch.
 
-    Zheng-Sederberg for rational patches, in the form that bounds the error at the same (u, v)
-    against the *affine* interpolant l of the samples.  With X = w (P - c) about the box centre
-    c: w (p - l) = X - w l =: F vanishes at the triangle's corners, so
-    |F| <= (1/8)(F_uu du^2 + 2 F_uv du dv + F_vv dv^2) and |p - l| <= |F| / min w, where
+    The piecewise-linear interpolant l of p = X / w on any triangle whose corners' u values
+    span at most du and v values at most dv satisfies, at the same (u, v),
 
-        |F_uu| <= |X_uu| + r |w_uu| + 2 |w_u| |l_u|,   |l_u| <= sup |p_u| <= (|X_u| + r |w_u|) / min w
+        |p - l| <= (1/8) (M_uu du^2 + 2 M_uv du dv + M_vv dv^2),   M_ab >= sup |p_ab|
 
-    and likewise F_vv, F_uv (= X_uv - w_uv l - w_u l_v - w_v l_u).  The |X|, |w| derivative
-    bounds come from the control-point differences (6 and 9 for second, 3 for first).  With
-    equal weights the w terms vanish and this is the paper's bound exactly; the paper's
-    ``max(r - eps, 0)`` bounds the distance to the projective interpolant L_X / L_w instead,
-    which is not the same (u, v) when the weights differ (DESIGN.md section 2).
+    (docs/rational-bound.md, Lemma 1).  The M's are bounds of the second derivatives of p itself
+    (second_derivative_bounds: Lemma 2), so the condition is zs_steps(M_uu, M_uv, M_vv, 8 eps).
     """
-    points = patch[..., :3] / patch[..., 3:]
-    centre = (points.min(axis=(0, 1)) + points.max(axis=(0, 1))) / 2
-    w = patch[..., 3]
-    x = patch[..., :3] - w[..., None] * centre  # translate to the box centre first
-    r = np.linalg.norm(points - centre, axis=-1).max()
-    w_min = w.min()
-
-    def norm_max(d):
-        return np.abs(d).max() if d.ndim == 2 else np.linalg.norm(d, axis=-1).max()
-
-    # [j, i]: u differences run along axis 1, v differences along axis 0.
-    def second_u(a): return a[:, 2:] - 2 * a[:, 1:-1] + a[:, :-2]
-    def second_v(a): return a[2:] - 2 * a[1:-1] + a[:-2]
-    def mixed(a): return a[1:, 1:] - a[1:, :-1] - a[:-1, 1:] + a[:-1, :-1]
-    def first_u(a): return a[:, 1:] - a[:, :-1]
-    def first_v(a): return a[1:] - a[:-1]
-
-    w_u, w_v = 3 * norm_max(first_u(w)), 3 * norm_max(first_v(w))
-    slope_u = (3 * norm_max(first_u(x)) + r * w_u) / w_min  # bounds |p_u|, hence |l_u|
-    slope_v = (3 * norm_max(first_v(x)) + r * w_v) / w_min
-    d_uu = 6 * norm_max(second_u(x)) + r * 6 * norm_max(second_u(w)) + 2 * w_u * slope_u
-    d_vv = 6 * norm_max(second_v(x)) + r * 6 * norm_max(second_v(w)) + 2 * w_v * slope_v
-    d_uv = 9 * norm_max(mixed(x)) + r * 9 * norm_max(mixed(w)) + w_u * slope_v + w_v * slope_u
-    du, dv = zs_steps(d_uu, d_uv, d_vv, 8 * eps * w_min)
+    m_uu, m_uv, m_vv = second_derivative_bounds(patch)
+    du, dv = zs_steps(m_uu, m_uv, m_vv, 8 * eps)
     return 1 / du, 1 / dv
+
+
+def second_derivative_bounds(patch: np.ndarray) -> tuple[float, float, float]:
+    """Bounds (M_uu, M_uv, M_vv) of |p_uu|, |p_uv|, |p_vv| over [0, 1]^2, p = X / w.
+
+    Quotient rule (docs/rational-bound.md, Lemma 2): with A_ab = w X_ab - w_ab X and
+    B_a = w X_a - w_a X,
+
+        w^3 p_uu = w A_uu - 2 w_u B_u,   w^3 p_uv = w A_uv - w_u B_v - w_v B_u,
+        w^3 p_vv = w A_vv - 2 w_v B_v,
+
+    polynomials whose Bernstein coefficients N_k (at w^3's degree (9, 9)) follow from products
+    of the control nets.  Then p_ab = sum_k (W_k B_k / w^3) (N_k / W_k), a convex combination
+    (W_k > 0 are w^3's coefficients), so |p_ab| <= max_k |N_k| / W_k: the rational convex hull.
+    With equal weights p_ab = X_ab / w directly, and the bounds are 6 and 9 times the largest
+    second differences over w: the polynomial Zheng-Sederberg bound, unchanged.
+    The numerators are translation-invariant; X is taken about the box centre to keep its
+    products small.
+    """
+    w = patch[..., 3:]
+    if (w == w[0, 0]).all():
+        x = patch[..., :3] / w  # [j, i]: u differences run along axis 1, v differences along axis 0
+        return (6 * np.linalg.norm(np.diff(x, 2, axis=1), axis=-1).max(),
+                9 * np.linalg.norm(np.diff(np.diff(x, axis=1), axis=0), axis=-1).max(),
+                6 * np.linalg.norm(np.diff(x, 2, axis=0), axis=-1).max())
+    points = patch[..., :3] / w
+    centre = (points.min(axis=(0, 1)) + points.max(axis=(0, 1))) / 2
+    h = np.concatenate([patch[..., :3] - w * centre, w], axis=-1)  # [j, i] = (X, w)
+    h_u, h_v = 3 * np.diff(h, axis=1), 3 * np.diff(h, axis=0)  # derivative nets (hodographs)
+    h_uu, h_uv, h_vv = 2 * np.diff(h_u, axis=1), 3 * np.diff(h_u, axis=0), 2 * np.diff(h_v, axis=0)
+
+    def wedge(a, b):  # a.w b.xyz - b.w a.xyz, as a Bernstein product
+        return _bernstein_product(a[..., 3:], b[..., :3]) - _bernstein_product(b[..., 3:], a[..., :3])
+
+    def scaled(a, b):  # a.w b
+        return _bernstein_product(a[..., 3:], b)
+
+    b_u, b_v = wedge(h, h_u), wedge(h, h_v)
+    numerators = (scaled(h, wedge(h, h_uu)) - 2 * scaled(h_u, b_u),
+                  scaled(h, wedge(h, h_uv)) - scaled(h_u, b_v) - scaled(h_v, b_u),
+                  scaled(h, wedge(h, h_vv)) - 2 * scaled(h_v, b_v))
+    cube = scaled(h, scaled(h, h[..., 3:]))[..., 0]  # w^3, degree (9, 9)
+    return tuple(float((np.linalg.norm(_elevate(n, cube.shape), axis=-1) / cube).max()) for n in numerators)
+
+
+def _binomials(shape) -> np.ndarray:
+    """C(n_v, j) C(n_u, i) for a net of the given (n_v + 1, n_u + 1) shape."""
+    return np.outer(*[[math.comb(n - 1, k) for k in range(n)] for n in shape[:2]])
+
+
+def _bernstein_product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Bernstein net of the product of two tensor-product polynomials (nets [j, i, ...], the
+    trailing axes multiplied elementwise): with c_k = C(n, k) b_k the product is a plain
+    convolution, c = a * b (Farin, "Curves and Surfaces for CAGD", section 6.11 on products)."""
+    a_scaled = a * _binomials(a.shape)[..., None]
+    b_scaled = b * _binomials(b.shape)[..., None]
+    shape = (a.shape[0] + b.shape[0] - 1, a.shape[1] + b.shape[1] - 1)
+    out = np.zeros(shape + np.broadcast_shapes(a.shape[2:], b.shape[2:]))
+    for j, i in np.ndindex(*a.shape[:2]):
+        out[j:j + b.shape[0], i:i + b.shape[1]] += a_scaled[j, i] * b_scaled
+    return out / _binomials(shape)[..., None]
+
+
+def _elevate(a: np.ndarray, shape) -> np.ndarray:
+    """Degree-elevate a net [j, i, ...] to ``shape`` (c_k = k/(n+1) a_{k-1} + (1 - k/(n+1)) a_k,
+    one degree at a time; each new coefficient is a convex combination of old ones)."""
+    for axis in (0, 1):
+        while a.shape[axis] < shape[axis]:
+            n = a.shape[axis] - 1
+            t = (np.arange(n + 2) / (n + 1)).reshape((-1, 1) if axis == 0 else (1, -1))[..., None]
+            pad = [(0, 0)] * a.ndim
+            pad[axis] = (1, 0)
+            lower = np.pad(a, pad)
+            pad[axis] = (0, 1)
+            upper = np.pad(a, pad)
+            a = t * lower + (1 - t) * upper
+    return a
 
 
 def zs_steps(d_uu: float, d_uv: float, d_vv: float, c: float) -> tuple[float, float]:
