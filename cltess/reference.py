@@ -101,25 +101,25 @@ def second_derivative_bounds(patch: np.ndarray) -> tuple[float, float, float]:
         w^3 p_uu = w A_uu - 2 w_u B_u,   w^3 p_uv = w A_uv - w_u B_v - w_v B_u,
         w^3 p_vv = w A_vv - 2 w_v B_v,
 
-    polynomials whose Bernstein coefficients N_k (at w^3's degree (9, 9)) follow from products
-    of the control nets.  Then p_ab = sum_k (W_k B_k / w^3) (N_k / W_k), a convex combination
-    (W_k > 0 are w^3's coefficients), so |p_ab| <= max_k |N_k| / W_k: the rational convex hull.
-    With equal weights p_ab = X_ab / w directly, and the bounds are 6 and 9 times the largest
-    second differences over w: the polynomial Zheng-Sederberg bound, unchanged.
-    The numerators are translation-invariant; X is taken about the box centre to keep its
-    products small.
+    polynomials of degree (9, 9) whose Bernstein coefficients N_k follow from products of the
+    control nets (every derivative net taken at degree (3, 3): CUBIC_DERIVATIVE).  Then
+    p_ab = sum_k (W_k B_k / w^3) (N_k / W_k), a convex combination (W_k > 0: w^3's coefficients),
+    so |p_ab| <= max_k |N_k| / W_k: the rational convex hull.  With equal weights p_ab = X_ab / w
+    directly and the bounds are 6, 9 and 6 times the largest second differences of the points:
+    the polynomial Zheng-Sederberg bound, unchanged.  The numerators are translation-invariant;
+    X is taken about the box centre to keep the products small.
     """
     w = patch[..., 3:]
+    points = patch[..., :3] / w  # [j, i]: u runs along axis 1, v along axis 0
     if (w == w[0, 0]).all():
-        x = patch[..., :3] / w  # [j, i]: u differences run along axis 1, v differences along axis 0
-        return (6 * np.linalg.norm(np.diff(x, 2, axis=1), axis=-1).max(),
-                9 * np.linalg.norm(np.diff(np.diff(x, axis=1), axis=0), axis=-1).max(),
-                6 * np.linalg.norm(np.diff(x, 2, axis=0), axis=-1).max())
-    points = patch[..., :3] / w
+        return (6 * np.linalg.norm(np.diff(points, 2, axis=1), axis=-1).max(),
+                9 * np.linalg.norm(np.diff(np.diff(points, axis=1), axis=0), axis=-1).max(),
+                6 * np.linalg.norm(np.diff(points, 2, axis=0), axis=-1).max())
     centre = (points.min(axis=(0, 1)) + points.max(axis=(0, 1))) / 2
-    h = np.concatenate([patch[..., :3] - w * centre, w], axis=-1)  # [j, i] = (X, w)
-    h_u, h_v = 3 * np.diff(h, axis=1), 3 * np.diff(h, axis=0)  # derivative nets (hodographs)
-    h_uu, h_uv, h_vv = 2 * np.diff(h_u, axis=1), 3 * np.diff(h_u, axis=0), 2 * np.diff(h_v, axis=0)
+    h = np.concatenate([patch[..., :3] - w * centre, w], axis=-1)  # (X, w)
+    d_u = lambda a: np.einsum("ki,jic->jkc", CUBIC_DERIVATIVE, a)  # noqa: E731
+    d_v = lambda a: np.einsum("kj,jic->kic", CUBIC_DERIVATIVE, a)  # noqa: E731
+    h_u, h_v = d_u(h), d_v(h)
 
     def wedge(a, b):  # a.w b.xyz - b.w a.xyz, as a Bernstein product
         return _bernstein_product(a[..., 3:], b[..., :3]) - _bernstein_product(b[..., 3:], a[..., :3])
@@ -128,11 +128,16 @@ def second_derivative_bounds(patch: np.ndarray) -> tuple[float, float, float]:
         return _bernstein_product(a[..., 3:], b)
 
     b_u, b_v = wedge(h, h_u), wedge(h, h_v)
-    numerators = (scaled(h, wedge(h, h_uu)) - 2 * scaled(h_u, b_u),
-                  scaled(h, wedge(h, h_uv)) - scaled(h_u, b_v) - scaled(h_v, b_u),
-                  scaled(h, wedge(h, h_vv)) - 2 * scaled(h_v, b_v))
-    cube = scaled(h, scaled(h, h[..., 3:]))[..., 0]  # w^3, degree (9, 9)
-    return tuple(float((np.linalg.norm(_elevate(n, cube.shape), axis=-1) / cube).max()) for n in numerators)
+    numerators = (scaled(h, wedge(h, d_u(h_u))) - 2 * scaled(h_u, b_u),
+                  scaled(h, wedge(h, d_v(h_u))) - scaled(h_u, b_v) - scaled(h_v, b_u),
+                  scaled(h, wedge(h, d_v(h_v))) - 2 * scaled(h_v, b_v))
+    cube = scaled(h, scaled(h, h[..., 3:]))[..., 0]  # w^3
+    return tuple(float((np.linalg.norm(n, axis=-1) / cube).max()) for n in numerators)
+
+
+# d/dt of a cubic, written again as a cubic: row k holds k (b_k - b_{k-1}) + (3 - k) (b_{k+1} - b_k),
+# the hodograph 3 (b_{i+1} - b_i) degree-elevated to 3.  Exact, so it can be applied twice.
+CUBIC_DERIVATIVE = np.array([[-3.0, 3, 0, 0], [-1, -1, 2, 0], [0, -2, 1, 1], [0, 0, -3, 3]])
 
 
 def _binomials(shape) -> np.ndarray:
@@ -142,8 +147,8 @@ def _binomials(shape) -> np.ndarray:
 
 def _bernstein_product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Bernstein net of the product of two tensor-product polynomials (nets [j, i, ...], the
-    trailing axes multiplied elementwise): with c_k = C(n, k) b_k the product is a plain
-    convolution, c = a * b (Farin, "Curves and Surfaces for CAGD", section 6.11 on products)."""
+    trailing axes multiplied elementwise): in the scaled basis C(n, k) B_k the product is a plain
+    convolution of the coefficients (Farin, "Curves and Surfaces for CAGD", 5th ed., 2002)."""
     a_scaled = a * _binomials(a.shape)[..., None]
     b_scaled = b * _binomials(b.shape)[..., None]
     shape = (a.shape[0] + b.shape[0] - 1, a.shape[1] + b.shape[1] - 1)
@@ -151,22 +156,6 @@ def _bernstein_product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     for j, i in np.ndindex(*a.shape[:2]):
         out[j:j + b.shape[0], i:i + b.shape[1]] += a_scaled[j, i] * b_scaled
     return out / _binomials(shape)[..., None]
-
-
-def _elevate(a: np.ndarray, shape) -> np.ndarray:
-    """Degree-elevate a net [j, i, ...] to ``shape`` (c_k = k/(n+1) a_{k-1} + (1 - k/(n+1)) a_k,
-    one degree at a time; each new coefficient is a convex combination of old ones)."""
-    for axis in (0, 1):
-        while a.shape[axis] < shape[axis]:
-            n = a.shape[axis] - 1
-            t = (np.arange(n + 2) / (n + 1)).reshape((-1, 1) if axis == 0 else (1, -1))[..., None]
-            pad = [(0, 0)] * a.ndim
-            pad[axis] = (1, 0)
-            lower = np.pad(a, pad)
-            pad[axis] = (0, 1)
-            upper = np.pad(a, pad)
-            a = t * lower + (1 - t) * upper
-    return a
 
 
 def zs_steps(d_uu: float, d_uv: float, d_vv: float, c: float) -> tuple[float, float]:

@@ -251,6 +251,127 @@ inline float2 zs_steps(float d_uu, float d_uv, float d_vv, float c)
     return (float2)(du, dv);
 }
 
+/* --- bounds of the second derivatives of p = X / w (reference.second_derivative_bounds) ------ */
+
+/* Pascal's triangle up to n = 9: C(n, k) = BINOMIAL[n (n + 1) / 2 + k]. */
+__constant float BINOMIAL[55] = {1, 1, 1, 1, 2, 1, 1, 3, 3, 1, 1, 4, 6, 4, 1, 1, 5, 10, 10, 5, 1,
+    1, 6, 15, 20, 15, 6, 1, 1, 7, 21, 35, 35, 21, 7, 1, 1, 8, 28, 56, 70, 56, 28, 8, 1,
+    1, 9, 36, 84, 126, 126, 84, 36, 9, 1};
+
+/* d/dt of a cubic written again as a cubic (reference.CUBIC_DERIVATIVE): row k of the matrix. */
+__constant float CUBIC_DERIVATIVE[16] = {-3, 3, 0, 0, -1, -1, 2, 0, 0, -2, 1, 1, 0, 0, -3, 3};
+
+/* out += coef * (a b), the Bernstein net of the product of square nets a (degree na in u and
+ * v, [j][i] row-major) and b (degree nb): c[J][I] = sum C(na,i1) C(na,j1) C(nb,i2) C(nb,j2) /
+ * (C(na+nb,I) C(na+nb,J)) a[j1][i1] b[j2][i2] over i1 + i2 = I, j1 + j2 = J (Farin).  The
+ * product of two terms is a.w b (wedge == 0) or (a.w b.xyz - b.w a.xyz, 0) (wedge == 1). */
+inline void bernstein_product(const float4 *a, int na, const float4 *b, int nb, int wedge, float coef,
+                              float4 *out)
+{
+    int n = na + nb;
+    const __constant float *ca = BINOMIAL + na * (na + 1) / 2, *cb = BINOMIAL + nb * (nb + 1) / 2,
+                           *cn = BINOMIAL + n * (n + 1) / 2;
+    for (int j1 = 0; j1 <= na; ++j1)
+        for (int i1 = 0; i1 <= na; ++i1) {
+            float4 x = a[j1 * (na + 1) + i1];
+            float wa = coef * ca[j1] * ca[i1];
+            for (int j2 = 0; j2 <= nb; ++j2)
+                for (int i2 = 0; i2 <= nb; ++i2) {
+                    float4 y = b[j2 * (nb + 1) + i2];
+                    float4 term = wedge ? (float4)(x.w * y.xyz - y.w * x.xyz, 0.0f) : x.w * y;
+                    float weight = wa * (cb[j2] * cb[i2]) / (cn[j1 + j2] * cn[i1 + i2]);
+                    out[(j1 + j2) * (n + 1) + i1 + i2] += weight * term;
+                }
+        }
+}
+
+/* out = d/du (along_u) or d/dv of the (3, 3) net a, as a (3, 3) net. */
+inline void cubic_derivative(const float4 a[16], int along_u, float4 out[16])
+{
+    for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i) {
+            float4 sum = 0.0f;
+            for (int k = 0; k < 4; ++k)
+                sum += along_u ? CUBIC_DERIVATIVE[4 * i + k] * a[4 * j + k] : CUBIC_DERIVATIVE[4 * j + k] * a[4 * k + i];
+            out[4 * j + i] = sum;
+        }
+}
+
+/* max_k |n_k.xyz| / cube_k over a (9, 9) net: the rational convex hull bound of n / w^3. */
+inline float hull_ratio(const float4 n[100], const float cube[100])
+{
+    float worst = 0.0f;
+    for (int k = 0; k < 100; ++k)
+        worst = max(worst, length(n[k].xyz) / cube[k]);
+    return worst;
+}
+
+/* (M_uu, M_uv, M_vv) >= sup |p_uu|, |p_uv|, |p_vv| over the patch, p = X / w (docs/rational-bound.md,
+ * Lemma 2): w^3 p_uu = w A_uu - 2 w_u B_u, w^3 p_uv = w A_uv - w_u B_v - w_v B_u, w^3 p_vv likewise,
+ * A_ab = w X_ab - w_ab X, B_a = w X_a - w_a X, all as (9, 9) Bernstein nets; |p_ab| <= max |N_k| / W_k.
+ * Equal weights: 6, 9, 6 times the largest second differences of the points (polynomial ZS). */
+inline float3 second_derivative_bounds(const float4 b[16])
+{
+    float3 lo = b[0].xyz / b[0].w, hi = lo;
+    int equal_weights = 1;
+    for (int k = 1; k < 16; ++k) {
+        lo = min(lo, b[k].xyz / b[k].w);
+        hi = max(hi, b[k].xyz / b[k].w);
+        equal_weights &= b[k].w == b[0].w;
+    }
+    if (equal_weights) {
+        float3 m = 0.0f;  /* .x uu, .y uv, .z vv, of the points */
+        float inv_w = 1.0f / b[0].w;
+        for (int j = 0; j < 4; ++j)
+            for (int i = 0; i < 2; ++i) {
+                m.x = max(m.x, length((b[4 * j + i + 2].xyz - 2.0f * b[4 * j + i + 1].xyz + b[4 * j + i].xyz) * inv_w));
+                m.z = max(m.z, length((b[4 * (i + 2) + j].xyz - 2.0f * b[4 * (i + 1) + j].xyz + b[4 * i + j].xyz) * inv_w));
+            }
+        for (int j = 0; j < 3; ++j)
+            for (int i = 0; i < 3; ++i)
+                m.y = max(m.y, length((b[4 * (j + 1) + i + 1].xyz - b[4 * (j + 1) + i].xyz
+                                       - b[4 * j + i + 1].xyz + b[4 * j + i].xyz) * inv_w));
+        return (float3)(6.0f, 9.0f, 6.0f) * m;
+    }
+
+    float3 centre = 0.5f * (lo + hi);  /* the numerators are translation-invariant: keep X small */
+    float4 h[16], h_u[16], h_v[16], second[16];
+    for (int k = 0; k < 16; ++k)
+        h[k] = (float4)(b[k].xyz - b[k].w * centre, b[k].w);
+    cubic_derivative(h, 1, h_u);
+    cubic_derivative(h, 0, h_v);
+
+    float4 b_u[49], b_v[49], a[49], n[100];
+    float cube[100];
+    for (int k = 0; k < 49; ++k)
+        b_u[k] = b_v[k] = a[k] = 0.0f;
+    for (int k = 0; k < 100; ++k)
+        n[k] = 0.0f;
+    bernstein_product(h, 3, h, 3, 0, 1.0f, a);  /* w^2 in .w */
+    bernstein_product(h, 3, a, 6, 0, 1.0f, n);  /* w^3 in .w */
+    for (int k = 0; k < 100; ++k)
+        cube[k] = n[k].w;
+    bernstein_product(h, 3, h_u, 3, 1, 1.0f, b_u);
+    bernstein_product(h, 3, h_v, 3, 1, 1.0f, b_v);
+
+    float bound[3];
+    for (int which = 0; which < 3; ++which) {  /* uu, uv, vv */
+        cubic_derivative(which == 2 ? h_v : h_u, which == 0, second);
+        for (int k = 0; k < 49; ++k)
+            a[k] = 0.0f;
+        for (int k = 0; k < 100; ++k)
+            n[k] = 0.0f;
+        bernstein_product(h, 3, second, 3, 1, 1.0f, a);  /* A = w X_ab - w_ab X */
+        bernstein_product(h, 3, a, 6, 0, 1.0f, n);
+        if (which != 2)
+            bernstein_product(h_u, 3, which == 0 ? b_u : b_v, 6, 0, which == 0 ? -2.0f : -1.0f, n);
+        if (which != 0)
+            bernstein_product(h_v, 3, which == 2 ? b_v : b_u, 6, 0, which == 2 ? -2.0f : -1.0f, n);
+        bound[which] = hull_ratio(n, cube);
+    }
+    return (float3)(bound[0], bound[1], bound[2]);
+}
+
 /* --- the quad pattern (DESIGN.md section 5, reference.quad_pattern) ---------------------------- */
 
 /* Core grid factors: the regular grid when uniform, else the inner grid of the ring pattern. */
