@@ -79,24 +79,55 @@ def zs_factors(patches: np.ndarray, eps: np.ndarray, culled: np.ndarray | None =
 def zs_inverse_steps(patch: np.ndarray, eps: float) -> tuple[float, float]:
     """(1/du, 1/dv) maximising du*dv under the error bound, for one (4, 4, 4) patch.
 
-    The piecewise-linear interpolant l of p = X / w on any triangle whose corners' u values
-    span at most du and v values at most dv satisfies, at the same (u, v),
+    The affine interpolant l of p = X / w on any triangle whose corners' u values span at most
+    du and v values at most dv satisfies, at the same (u, v) (docs/rational-bound.md):
 
-        |p - l| <= (1/8) (M_uu du^2 + 2 M_uv du dv + M_vv dv^2),   M_ab >= sup |p_ab|
+        Lemma 1:  |p - l| <= (1/8) (M_uu du^2 + 2 M_uv du dv + M_vv dv^2),   M_ab >= sup |p_ab|
+        Lemma 3:  |p - l| <= (1/8) (alpha du^2 + gamma dv^2)  if  |D^2 p [h, h]| <= alpha h_u^2 + gamma h_v^2
 
-    (docs/rational-bound.md, Lemma 1).  The M's are bounds of the second derivatives of p itself
-    (second_derivative_bounds: Lemma 2), so the condition is zs_steps(M_uu, M_uv, M_vv, 8 eps).
+    The M's come from the rational convex hull of (p_uu, p_uv, p_vv) (Lemma 2,
+    second_derivative_hull); Lemma 3's alpha, gamma = rho alpha from the same hull
+    (diagonal_majorant), rho = M_vv / M_uu.  Of the two step pairs the one with the larger
+    du*dv is taken.  Equal weights: the polynomial Zheng-Sederberg bound, unchanged (Lemma 1 with
+    second_derivative_bounds).
     """
-    m_uu, m_uv, m_vv = second_derivative_bounds(patch)
+    w = patch[..., 3]
+    if (w == w[0, 0]).all():
+        du, dv = zs_steps(*second_derivative_bounds(patch), 8 * eps)
+        return 1 / du, 1 / dv
+    hull = second_derivative_hull(patch)
+    m_uu, m_uv, m_vv = np.linalg.norm(hull, axis=-1).max(axis=0)
     du, dv = zs_steps(m_uu, m_uv, m_vv, 8 * eps)
+    if m_uu > 0 and m_vv > 0:
+        rho = m_vv / m_uu
+        alpha = diagonal_majorant(hull, rho)
+        du_3, dv_3 = min(math.sqrt(4 * eps / alpha), 1.0), min(math.sqrt(4 * eps / (rho * alpha)), 1.0)
+        if du_3 * dv_3 > du * dv:
+            du, dv = du_3, dv_3
     return 1 / du, 1 / dv
 
 
 def second_derivative_bounds(patch: np.ndarray) -> tuple[float, float, float]:
     """Bounds (M_uu, M_uv, M_vv) of |p_uu|, |p_uv|, |p_vv| over [0, 1]^2, p = X / w.
 
-    Quotient rule (docs/rational-bound.md, Lemma 2): with A_ab = w X_ab - w_ab X and
-    B_a = w X_a - w_a X,
+    Rational: the largest norms over second_derivative_hull.  Equal weights w: p_ab = X_ab / w
+    directly, and the bounds are 6, 9 and 6 times the largest second differences of the points,
+    the polynomial Zheng-Sederberg bound.
+    """
+    w = patch[..., 3:]
+    if not (w == w[0, 0]).all():
+        return tuple(float(m) for m in np.linalg.norm(second_derivative_hull(patch), axis=-1).max(axis=0))
+    points = patch[..., :3] / w  # [j, i]: u runs along axis 1, v along axis 0
+    return (6 * np.linalg.norm(np.diff(points, 2, axis=1), axis=-1).max(),
+            9 * np.linalg.norm(np.diff(np.diff(points, axis=1), axis=0), axis=-1).max(),
+            6 * np.linalg.norm(np.diff(points, 2, axis=0), axis=-1).max())
+
+
+def second_derivative_hull(patch: np.ndarray) -> np.ndarray:
+    """(100, 3, 3): points H_k = (N_uu,k, N_uv,k, N_vv,k) / W_k whose convex hull holds
+    (p_uu, p_uv, p_vv) everywhere on [0, 1]^2, p = X / w (docs/rational-bound.md, Lemma 2).
+
+    Quotient rule: with A_ab = w X_ab - w_ab X and B_a = w X_a - w_a X,
 
         w^3 p_uu = w A_uu - 2 w_u B_u,   w^3 p_uv = w A_uv - w_u B_v - w_v B_u,
         w^3 p_vv = w A_vv - 2 w_v B_v,
@@ -104,19 +135,13 @@ def second_derivative_bounds(patch: np.ndarray) -> tuple[float, float, float]:
     polynomials of degree (9, 9) whose Bernstein coefficients N_k follow from products of the
     control nets (every derivative net taken at degree (3, 3): CUBIC_DERIVATIVE).  Then
     p_ab = sum_k (W_k B_k / w^3) (N_k / W_k), a convex combination (W_k > 0: w^3's coefficients),
-    so |p_ab| <= max_k |N_k| / W_k: the rational convex hull.  With equal weights p_ab = X_ab / w
-    directly and the bounds are 6, 9 and 6 times the largest second differences of the points:
-    the polynomial Zheng-Sederberg bound, unchanged.  The numerators are translation-invariant;
-    X is taken about the box centre to keep the products small.
+    the same one for all three.  The numerators are translation-invariant; X is taken about the
+    box centre to keep the products small.
     """
     w = patch[..., 3:]
-    points = patch[..., :3] / w  # [j, i]: u runs along axis 1, v along axis 0
-    if (w == w[0, 0]).all():
-        return (6 * np.linalg.norm(np.diff(points, 2, axis=1), axis=-1).max(),
-                9 * np.linalg.norm(np.diff(np.diff(points, axis=1), axis=0), axis=-1).max(),
-                6 * np.linalg.norm(np.diff(points, 2, axis=0), axis=-1).max())
+    points = patch[..., :3] / w
     centre = (points.min(axis=(0, 1)) + points.max(axis=(0, 1))) / 2
-    h = np.concatenate([patch[..., :3] - w * centre, w], axis=-1)  # (X, w)
+    h = np.concatenate([patch[..., :3] - w * centre, w], axis=-1)  # (X, w), [j, i]
     d_u = lambda a: np.einsum("ki,jic->jkc", CUBIC_DERIVATIVE, a)  # noqa: E731
     d_v = lambda a: np.einsum("kj,jic->kic", CUBIC_DERIVATIVE, a)  # noqa: E731
     h_u, h_v = d_u(h), d_v(h)
@@ -131,8 +156,26 @@ def second_derivative_bounds(patch: np.ndarray) -> tuple[float, float, float]:
     numerators = (scaled(h, wedge(h, d_u(h_u))) - 2 * scaled(h_u, b_u),
                   scaled(h, wedge(h, d_v(h_u))) - scaled(h_u, b_v) - scaled(h_v, b_u),
                   scaled(h, wedge(h, d_v(h_v))) - 2 * scaled(h_v, b_v))
-    cube = scaled(h, scaled(h, h[..., 3:]))[..., 0]  # w^3
-    return tuple(float((np.linalg.norm(n, axis=-1) / cube).max()) for n in numerators)
+    cube = scaled(h, scaled(h, h[..., 3:]))  # w^3
+    return np.stack([n / cube for n in numerators], axis=2).reshape(-1, 3, 3)
+
+
+def diagonal_majorant(hull: np.ndarray, rho: float) -> float:
+    """Smallest alpha this bound finds with |H_k[h, h]| <= alpha (h_u^2 + rho h_v^2) for every
+    hull point H_k = (a, b, c) and every h, H[h, h] = a h_u^2 + 2 b h_u h_v + c h_v^2
+    (docs/rational-bound.md, Lemma 3).
+
+    With h = (cos t, sin t / sqrt(rho)) |h|_rho: H[h, h] / |h|_rho^2 = p + q cos 2t + r sin 2t,
+    p = (a + c / rho) / 2, q = (a - c / rho) / 2, r = b / sqrt(rho), a point of an ellipse, and
+    |p + v|^2 <= |p|^2 + 2 sqrt((p.q)^2 + (p.r)^2) + s^2 with s the largest singular value of
+    [q r].  alpha is the largest of these over k.
+    """
+    a, b, c = hull[:, 0], hull[:, 1], hull[:, 2]
+    p, q, r = (a + c / rho) / 2, (a - c / rho) / 2, b / math.sqrt(rho)
+    dot = lambda x, y: (x * y).sum(axis=1)  # noqa: E731
+    qq, rr, qr = dot(q, q), dot(r, r), dot(q, r)
+    s2 = (qq + rr) / 2 + np.sqrt(((qq - rr) / 2) ** 2 + qr ** 2)
+    return float(np.sqrt(dot(p, p) + 2 * np.sqrt(dot(p, q) ** 2 + dot(p, r) ** 2) + s2).max())
 
 
 # d/dt of a cubic, written again as a cubic: row k holds k (b_k - b_{k-1}) + (3 - k) (b_{k+1} - b_k),

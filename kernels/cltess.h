@@ -251,7 +251,7 @@ inline float2 zs_steps(float d_uu, float d_uv, float d_vv, float c)
     return (float2)(du, dv);
 }
 
-/* --- bounds of the second derivatives of p = X / w (reference.second_derivative_bounds) ------ */
+/* --- Zheng-Sederberg steps from bounds of p = X / w itself (reference.zs_inverse_steps) ----- */
 
 /* Pascal's triangle up to n = 9: C(n, k) = BINOMIAL[n (n + 1) / 2 + k]. */
 __constant float BINOMIAL[55] = {1, 1, 1, 1, 2, 1, 1, 3, 3, 1, 1, 4, 6, 4, 1, 1, 5, 10, 10, 5, 1,
@@ -297,20 +297,14 @@ inline void cubic_derivative(const float4 a[16], int along_u, float4 out[16])
         }
 }
 
-/* max_k |n_k.xyz| / cube_k over a (9, 9) net: the rational convex hull bound of n / w^3. */
-inline float hull_ratio(const float4 n[100], const float cube[100])
-{
-    float worst = 0.0f;
-    for (int k = 0; k < 100; ++k)
-        worst = max(worst, length(n[k].xyz) / cube[k]);
-    return worst;
-}
-
-/* (M_uu, M_uv, M_vv) >= sup |p_uu|, |p_uv|, |p_vv| over the patch, p = X / w (docs/rational-bound.md,
- * Lemma 2): w^3 p_uu = w A_uu - 2 w_u B_u, w^3 p_uv = w A_uv - w_u B_v - w_v B_u, w^3 p_vv likewise,
- * A_ab = w X_ab - w_ab X, B_a = w X_a - w_a X, all as (9, 9) Bernstein nets; |p_ab| <= max |N_k| / W_k.
- * Equal weights: 6, 9, 6 times the largest second differences of the points (polynomial ZS). */
-inline float3 second_derivative_bounds(const float4 b[16])
+/* The steps' inverses (1/du, 1/dv) for a patch and tolerance eps (reference.zs_inverse_steps,
+ * docs/rational-bound.md).  Equal weights: Lemma 1 with 6, 9, 6 times the largest second
+ * differences of the points (polynomial Zheng-Sederberg).  Rational: the hull points
+ * H_k = (N_uu, N_uv, N_vv)_k / W_k of (p_uu, p_uv, p_vv) (Lemma 2: w^3 p_uu = w A_uu - 2 w_u B_u,
+ * w^3 p_uv = w A_uv - w_u B_v - w_v B_u, w^3 p_vv likewise, A_ab = w X_ab - w_ab X,
+ * B_a = w X_a - w_a X, all (9, 9) Bernstein nets); steps from Lemma 1 with M_ab = max |H_k.ab|,
+ * or from Lemma 3 (alpha h_u^2 + gamma h_v^2 majorises every |H_k[h, h]|) when those are larger. */
+inline float2 zs_inverse_steps(const float4 b[16], float eps)
 {
     float3 lo = b[0].xyz / b[0].w, hi = lo;
     int equal_weights = 1;
@@ -331,7 +325,7 @@ inline float3 second_derivative_bounds(const float4 b[16])
             for (int i = 0; i < 3; ++i)
                 m.y = max(m.y, length((b[4 * (j + 1) + i + 1].xyz - b[4 * (j + 1) + i].xyz
                                        - b[4 * j + i + 1].xyz + b[4 * j + i].xyz) * inv_w));
-        return (float3)(6.0f, 9.0f, 6.0f) * m;
+        return 1.0f / zs_steps(6.0f * m.x, 9.0f * m.y, 6.0f * m.z, 8.0f * eps);
     }
 
     float3 centre = 0.5f * (lo + hi);  /* the numerators are translation-invariant: keep X small */
@@ -341,35 +335,57 @@ inline float3 second_derivative_bounds(const float4 b[16])
     cubic_derivative(h, 1, h_u);
     cubic_derivative(h, 0, h_v);
 
-    float4 b_u[49], b_v[49], a[49], n[100];
+    float4 b_u[49], b_v[49], a[49], hull[3][100];
     float cube[100];
     for (int k = 0; k < 49; ++k)
         b_u[k] = b_v[k] = a[k] = 0.0f;
     for (int k = 0; k < 100; ++k)
-        n[k] = 0.0f;
-    bernstein_product(h, 3, h, 3, 0, 1.0f, a);  /* w^2 in .w */
-    bernstein_product(h, 3, a, 6, 0, 1.0f, n);  /* w^3 in .w */
+        hull[0][k] = hull[1][k] = hull[2][k] = 0.0f;
+    bernstein_product(h, 3, h, 3, 0, 1.0f, a);        /* w^2 in .w */
+    bernstein_product(h, 3, a, 6, 0, 1.0f, hull[0]);  /* w^3 in .w */
     for (int k = 0; k < 100; ++k)
-        cube[k] = n[k].w;
+        cube[k] = hull[0][k].w;
+    for (int k = 0; k < 100; ++k)
+        hull[0][k] = 0.0f;
     bernstein_product(h, 3, h_u, 3, 1, 1.0f, b_u);
     bernstein_product(h, 3, h_v, 3, 1, 1.0f, b_v);
 
-    float bound[3];
-    for (int which = 0; which < 3; ++which) {  /* uu, uv, vv */
+    float3 m = 0.0f;  /* .x uu, .y uv, .z vv */
+    for (int which = 0; which < 3; ++which) {
+        float4 *n = hull[which];
         cubic_derivative(which == 2 ? h_v : h_u, which == 0, second);
         for (int k = 0; k < 49; ++k)
             a[k] = 0.0f;
-        for (int k = 0; k < 100; ++k)
-            n[k] = 0.0f;
         bernstein_product(h, 3, second, 3, 1, 1.0f, a);  /* A = w X_ab - w_ab X */
         bernstein_product(h, 3, a, 6, 0, 1.0f, n);
         if (which != 2)
             bernstein_product(h_u, 3, which == 0 ? b_u : b_v, 6, 0, which == 0 ? -2.0f : -1.0f, n);
         if (which != 0)
             bernstein_product(h_v, 3, which == 2 ? b_v : b_u, 6, 0, which == 2 ? -2.0f : -1.0f, n);
-        bound[which] = hull_ratio(n, cube);
+        float worst = 0.0f;
+        for (int k = 0; k < 100; ++k) {
+            n[k] /= cube[k];
+            worst = max(worst, length(n[k].xyz));
+        }
+        if (which == 0) m.x = worst; else if (which == 1) m.y = worst; else m.z = worst;
     }
-    return (float3)(bound[0], bound[1], bound[2]);
+    float2 step = zs_steps(m.x, m.y, m.z, 8.0f * eps);  /* Lemma 1 */
+
+    if (m.x > 0.0f && m.z > 0.0f) {  /* Lemma 3 (reference.diagonal_majorant), rho = M_vv / M_uu */
+        float rho = m.z / m.x, root_rho = sqrt(rho), alpha = 0.0f;
+        for (int k = 0; k < 100; ++k) {
+            float3 p = 0.5f * (hull[0][k].xyz + hull[2][k].xyz / rho);
+            float3 q = 0.5f * (hull[0][k].xyz - hull[2][k].xyz / rho);
+            float3 r = hull[1][k].xyz / root_rho;
+            float qq = dot(q, q), rr = dot(r, r), qr = dot(q, r), pq = dot(p, q), pr = dot(p, r);
+            float s2 = 0.5f * (qq + rr) + sqrt(0.25f * (qq - rr) * (qq - rr) + qr * qr);
+            alpha = max(alpha, sqrt(dot(p, p) + 2.0f * sqrt(pq * pq + pr * pr) + s2));
+        }
+        float2 diagonal = (float2)(min(sqrt(4.0f * eps / alpha), 1.0f), min(sqrt(4.0f * eps / (rho * alpha)), 1.0f));
+        if (diagonal.x * diagonal.y > step.x * step.y)
+            step = diagonal;
+    }
+    return 1.0f / step;
 }
 
 /* --- the quad pattern (DESIGN.md section 5, reference.quad_pattern) ---------------------------- */

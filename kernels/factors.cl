@@ -74,10 +74,7 @@ __kernel void zs_factors(__global const float4 *patches, uint num_patches, uint 
         return;
     }
 
-    /* (1/8)(M_uu du^2 + 2 M_uv du dv + M_vv dv^2) <= tol (docs/rational-bound.md) */
-    float3 bound = second_derivative_bounds(b);
-    float2 step = zs_steps(bound.x, bound.y, bound.z, 8.0f * tol);
-    float2 inverse = 1.0f / step;
+    float2 inverse = zs_inverse_steps(b, tol);  /* docs/rational-bound.md */
     int saturated = 0;
     int m = edge_factor(inverse.x, max_factor, &saturated);
     int n = edge_factor(inverse.y, max_factor, &saturated);

@@ -96,6 +96,21 @@ def test_second_derivative_bounds_hold_and_are_tight(rng):
             assert all(b <= 1.2 * s for s, b in zip(sampled, bounds)), (k, sampled, bounds)
 
 
+def test_diagonal_majorant_holds_in_every_direction(rng):
+    """|H_k[h, h]| <= alpha (h_u^2 + rho h_v^2) for every hull point and many directions h, and
+    alpha is attained within 10% on some direction (Lemma 3 of docs/rational-bound.md)."""
+    angle = np.linspace(0, np.pi, 721)
+    h_u, h_v = np.cos(angle), np.sin(angle)
+    for patch in random_patches(rng, 30):
+        hull = reference.second_derivative_hull(patch)
+        for rho in (0.1, 1.0, 7.0):
+            alpha = reference.diagonal_majorant(hull, rho)
+            form = (hull[:, None, 0] * (h_u * h_u)[:, None] + 2 * hull[:, None, 1] * (h_u * h_v)[:, None]
+                    + hull[:, None, 2] * (h_v * h_v)[:, None])  # (K, directions, 3)
+            ratio = np.linalg.norm(form, axis=-1) / (alpha * (h_u * h_u + rho * h_v * h_v))
+            assert ratio.max() <= 1 + 1e-12 and ratio.max() > 0.9, ratio.max()
+
+
 @settings(max_examples=30, deadline=None)
 @given(d_uu=st.floats(0, 1e3), d_uv=st.floats(0, 1e3), d_vv=st.floats(0, 1e3), c=st.floats(1e-6, 1e2))
 def test_zs_steps_keep_the_bound_and_are_at_most_one(d_uu, d_uv, d_vv, c):
