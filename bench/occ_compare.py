@@ -9,8 +9,10 @@ cltess's dependencies) besides cltess itself:
 
 Scenes: the exact rational torus (scenes/torus.bpt), 20 random rational patches (weights 0.2 to
 5, the recipe of tests/support.random_patches, seed 1) and the teapot (polynomial).  cltess runs at
-several eps, OpenCASCADE's BRepMesh_IncrementalMesh at several linear deflections (angular
-deflection 0.5 rad, its default, and 1.5 rad, nearly off), each patch one face of a compound.
+several eps, OpenCASCADE's BRepMesh_IncrementalMesh at linear deflections from 1e-1 of the
+diagonal down by sqrt(10) at a time until its measured deviation is below cltess's smallest
+(or 2 million triangles; angular deflection 0.5 rad, its default, and 1.5 rad, nearly off), each patch one face of a
+compound.
 
 Every mesh is measured the same way, independently of both programs' own estimates: densely
 inside every triangle (barycentric samples of order 6, edges included) the distance between the
@@ -32,8 +34,10 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "scenes"
-RELATIVE_EPS = [1e-2, 3e-3, 1e-3]  # of the bounding-box diagonal
-RELATIVE_DEFLECTIONS = [3e-2, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5]
+RELATIVE_EPS = [3e-2, 1e-2, 3e-3, 1e-3]  # of the bounding-box diagonal
+LARGEST_DEFLECTION = 1e-1  # of the diagonal; then / sqrt(10) at a time, until OCC's measured
+MAX_OCC_RUNS = 12          # deviation is below cltess's smallest (or this many runs per angle,
+MAX_OCC_TRIANGLES = 2_000_000  # or this many triangles)
 ANGLES = [0.5, 1.5]
 
 
@@ -182,12 +186,23 @@ def triangles_at(front: list[tuple[float, float]], deviation: float) -> float | 
     return None
 
 
+def print_cltess_rows(label: str, rows: list[dict], front, size: float) -> None:
+    for r in rows:
+        occ = triangles_at(front, r["deviation"])
+        ratio = f"{r['triangles'] / occ:.2f}" if occ else "n/a"
+        print(f"| {label} | {r['eps'] / size:.0e} | {r['triangles']} | {r['deviation'] / r['eps']:.3f} | "
+              f"{r['deviation'] / size:.2e} | {f'{occ:.0f}' if occ else 'n/a'} | {ratio} |")
+
+
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--scenes", nargs="+", default=["torus", "random", "teapot", "sphere"])
     parser.add_argument("--json", type=Path, help="write every run here")
     parser.add_argument("--no-occ", action="store_true", help="cltess only (e.g. to compare two versions)")
+    parser.add_argument("--baseline", type=Path, help="a --json of another cltess version: its rows too")
+    parser.add_argument("--baseline-label", default="baseline")
     args = parser.parse_args(argv)
+    baseline = json.loads(args.baseline.read_text()) if args.baseline else None
 
     import cltess
 
@@ -196,23 +211,27 @@ def main(argv=None) -> None:
         patches = load_patches(name)
         size = diagonal(patches)
         runs = {"diagonal": size, "cltess": [run_cltess(patches, e * size) for e in RELATIVE_EPS], "occ": []}
-        if not args.no_occ:
-            runs["occ"] = [run_occ(patches, d * size, a) for a in ANGLES for d in RELATIVE_DEFLECTIONS]
+        rows = runs["cltess"] + (baseline["scenes"].get(name, {}).get("cltess", []) if baseline else [])
+        target = min(r["deviation"] for r in rows)
+        for angle in ANGLES if not args.no_occ else []:
+            for k in range(MAX_OCC_RUNS):
+                runs["occ"].append(run_occ(patches, LARGEST_DEFLECTION * size / 10 ** (k / 2), angle))
+                if runs["occ"][-1]["deviation"] < target or runs["occ"][-1]["triangles"] > MAX_OCC_TRIANGLES:
+                    break
         results["scenes"][name] = runs
         front = pareto(runs["occ"])
         print(f"\n### {name} ({len(patches)} patches, diagonal {size:.3g})\n")
-        print("| cltess eps / diag | triangles | measured dev / eps | measured dev / diag | OCC triangles at that dev | cltess / OCC |")
-        print("|---|---|---|---|---|---|")
-        for r in runs["cltess"]:
-            occ = triangles_at(front, r["deviation"])
-            ratio = f"{r['triangles'] / occ:.2f}" if occ else "n/a"
-            print(f"| {r['eps'] / size:.0e} | {r['triangles']} | {r['deviation'] / r['eps']:.3f} | "
-                  f"{r['deviation'] / size:.2e} | {f'{occ:.0f}' if occ else 'n/a'} | {ratio} |")
+        print("| cltess | eps / diag | triangles | measured dev / eps | measured dev / diag "
+              "| OCC triangles at that dev | cltess / OCC |")
+        print("|---|---|---|---|---|---|---|")
+        print_cltess_rows("this", runs["cltess"], front, size)
+        if baseline and name in baseline["scenes"]:
+            print_cltess_rows(args.baseline_label, baseline["scenes"][name]["cltess"], front, size)
         if runs["occ"]:
             print("\n| OCC deflection / diag | angle | triangles | measured dev / deflection | measured dev / diag |")
             print("|---|---|---|---|---|")
             for r in runs["occ"]:
-                print(f"| {r['deflection'] / size:.0e} | {r['angle']} | {r['triangles']} | "
+                print(f"| {r['deflection'] / size:.1e} | {r['angle']} | {r['triangles']} | "
                       f"{r['deviation'] / r['deflection']:.2f} | {r['deviation'] / size:.2e} |")
         sys.stdout.flush()
     if args.json:
