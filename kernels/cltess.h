@@ -253,47 +253,47 @@ inline float2 zs_steps(float d_uu, float d_uv, float d_vv, float c)
 
 /* --- Zheng-Sederberg steps from bounds of p = X / w itself (reference.zs_inverse_steps) ----- */
 
-/* Pascal's triangle up to n = 9: C(n, k) = BINOMIAL[n (n + 1) / 2 + k]. */
-__constant float BINOMIAL[55] = {1, 1, 1, 1, 2, 1, 1, 3, 3, 1, 1, 4, 6, 4, 1, 1, 5, 10, 10, 5, 1,
-    1, 6, 15, 20, 15, 6, 1, 1, 7, 21, 35, 35, 21, 7, 1, 1, 8, 28, 56, 70, 56, 28, 8, 1,
-    1, 9, 36, 84, 126, 126, 84, 36, 9, 1};
+/* The nets below are kept in the scaled Bernstein basis C(n, i) C(n, j) B_i(u) B_j(v): there a
+ * product of polynomials is a plain convolution of the coefficients (Farin), and the ratio N_k / W_k
+ * of two (9, 9) nets is the same as in the plain basis (both carry C(9, i) C(9, j)). */
 
-/* d/dt of a cubic written again as a cubic (reference.CUBIC_DERIVATIVE): row k of the matrix. */
-__constant float CUBIC_DERIVATIVE[16] = {-3, 3, 0, 0, -1, -1, 2, 0, 0, -2, 1, 1, 0, 0, -3, 3};
+/* d/dt of a cubic written again as a cubic, in the scaled basis: C(3, k) CUBIC_DERIVATIVE[k][m] /
+ * C(3, m) (reference.CUBIC_DERIVATIVE), row k of the matrix. */
+__constant float SCALED_CUBIC_DERIVATIVE[16] = {-3, 1, 0, 0, -3, -1, 2, 0, 0, -2, 1, 3, 0, 0, -1, 3};
 
-/* out += coef * (a b), the Bernstein net of the product of square nets a (degree na in u and
- * v, [j][i] row-major) and b (degree nb): c[J][I] = sum C(na,i1) C(na,j1) C(nb,i2) C(nb,j2) /
- * (C(na+nb,I) C(na+nb,J)) a[j1][i1] b[j2][i2] over i1 + i2 = I, j1 + j2 = J (Farin).  The
- * product of two terms is a.w b (wedge == 0) or (a.w b.xyz - b.w a.xyz, 0) (wedge == 1). */
-inline void bernstein_product(const float4 *a, int na, const float4 *b, int nb, int wedge, float coef,
-                              float4 *out)
-{
-    int n = na + nb;
-    const __constant float *ca = BINOMIAL + na * (na + 1) / 2, *cb = BINOMIAL + nb * (nb + 1) / 2,
-                           *cn = BINOMIAL + n * (n + 1) / 2;
-    for (int j1 = 0; j1 <= na; ++j1)
-        for (int i1 = 0; i1 <= na; ++i1) {
-            float4 x = a[j1 * (na + 1) + i1];
-            float wa = coef * ca[j1] * ca[i1];
-            for (int j2 = 0; j2 <= nb; ++j2)
-                for (int i2 = 0; i2 <= nb; ++i2) {
-                    float4 y = b[j2 * (nb + 1) + i2];
-                    float4 term = wedge ? (float4)(x.w * y.xyz - y.w * x.xyz, 0.0f) : x.w * y;
-                    float weight = wa * (cb[j2] * cb[i2]) / (cn[j1 + j2] * cn[i1 + i2]);
-                    out[(j1 + j2) * (n + 1) + i1 + i2] += weight * term;
-                }
-        }
-}
-
-/* out = d/du (along_u) or d/dv of the (3, 3) net a, as a (3, 3) net. */
+/* out = d/du (along_u) or d/dv of the scaled (3, 3) net a, as a scaled (3, 3) net. */
 inline void cubic_derivative(const float4 a[16], int along_u, float4 out[16])
 {
     for (int j = 0; j < 4; ++j)
         for (int i = 0; i < 4; ++i) {
             float4 sum = 0.0f;
             for (int k = 0; k < 4; ++k)
-                sum += along_u ? CUBIC_DERIVATIVE[4 * i + k] * a[4 * j + k] : CUBIC_DERIVATIVE[4 * j + k] * a[4 * k + i];
+                sum += along_u ? SCALED_CUBIC_DERIVATIVE[4 * i + k] * a[4 * j + k]
+                               : SCALED_CUBIC_DERIVATIVE[4 * j + k] * a[4 * k + i];
             out[4 * j + i] = sum;
+        }
+}
+
+/* out += coef a.w b: scaled nets a of degree (na, na) and b of degree (nb, nb), [j][i] row-major. */
+inline void convolve_scaled(const float4 *a, int na, const float4 *b, int nb, float coef, float4 *out)
+{
+    int stride = na + nb + 1;
+    for (int j1 = 0; j1 <= na; ++j1)
+        for (int i1 = 0; i1 <= na; ++i1) {
+            float x = coef * a[j1 * (na + 1) + i1].w;
+            for (int j2 = 0; j2 <= nb; ++j2)
+                for (int i2 = 0; i2 <= nb; ++i2)
+                    out[(j1 + j2) * stride + i1 + i2] += x * b[j2 * (nb + 1) + i2];
+        }
+}
+
+/* out += (a.w b.xyz - b.w a.xyz, 0) for scaled (3, 3) nets, out (6, 6). */
+inline void convolve_wedge(const float4 a[16], const float4 b[16], float4 out[49])
+{
+    for (int k1 = 0; k1 < 16; ++k1)
+        for (int k2 = 0; k2 < 16; ++k2) {
+            float4 x = a[k1], y = b[k2];
+            out[(k1 / 4 + k2 / 4) * 7 + k1 % 4 + k2 % 4] += (float4)(x.w * y.xyz - y.w * x.xyz, 0.0f);
         }
 }
 
@@ -330,8 +330,12 @@ inline float2 zs_inverse_steps(const float4 b[16], float eps)
 
     float3 centre = 0.5f * (lo + hi);  /* the numerators are translation-invariant: keep X small */
     float4 h[16], h_u[16], h_v[16], second[16];
-    for (int k = 0; k < 16; ++k)
-        h[k] = (float4)(b[k].xyz - b[k].w * centre, b[k].w);
+    for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i) {  /* scaled by C(3, i) C(3, j) */
+            float binomial = ((i == 1 || i == 2) ? 3.0f : 1.0f) * ((j == 1 || j == 2) ? 3.0f : 1.0f);
+            float4 x = b[4 * j + i];
+            h[4 * j + i] = binomial * (float4)(x.xyz - x.w * centre, x.w);
+        }
     cubic_derivative(h, 1, h_u);
     cubic_derivative(h, 0, h_v);
 
@@ -340,15 +344,15 @@ inline float2 zs_inverse_steps(const float4 b[16], float eps)
     for (int k = 0; k < 49; ++k)
         b_u[k] = b_v[k] = a[k] = 0.0f;
     for (int k = 0; k < 100; ++k)
-        hull[0][k] = hull[1][k] = hull[2][k] = 0.0f;
-    bernstein_product(h, 3, h, 3, 0, 1.0f, a);        /* w^2 in .w */
-    bernstein_product(h, 3, a, 6, 0, 1.0f, hull[0]);  /* w^3 in .w */
-    for (int k = 0; k < 100; ++k)
-        cube[k] = hull[0][k].w;
-    for (int k = 0; k < 100; ++k)
         hull[0][k] = 0.0f;
-    bernstein_product(h, 3, h_u, 3, 1, 1.0f, b_u);
-    bernstein_product(h, 3, h_v, 3, 1, 1.0f, b_v);
+    convolve_scaled(h, 3, h, 3, 1.0f, a);        /* w^2 in .w */
+    convolve_scaled(h, 3, a, 6, 1.0f, hull[0]);  /* w^3 in .w */
+    for (int k = 0; k < 100; ++k) {
+        cube[k] = hull[0][k].w;
+        hull[0][k] = hull[1][k] = hull[2][k] = 0.0f;
+    }
+    convolve_wedge(h, h_u, b_u);
+    convolve_wedge(h, h_v, b_v);
 
     float3 m = 0.0f;  /* .x uu, .y uv, .z vv */
     for (int which = 0; which < 3; ++which) {
@@ -356,12 +360,12 @@ inline float2 zs_inverse_steps(const float4 b[16], float eps)
         cubic_derivative(which == 2 ? h_v : h_u, which == 0, second);
         for (int k = 0; k < 49; ++k)
             a[k] = 0.0f;
-        bernstein_product(h, 3, second, 3, 1, 1.0f, a);  /* A = w X_ab - w_ab X */
-        bernstein_product(h, 3, a, 6, 0, 1.0f, n);
+        convolve_wedge(h, second, a);  /* A = w X_ab - w_ab X */
+        convolve_scaled(h, 3, a, 6, 1.0f, n);
         if (which != 2)
-            bernstein_product(h_u, 3, which == 0 ? b_u : b_v, 6, 0, which == 0 ? -2.0f : -1.0f, n);
+            convolve_scaled(h_u, 3, which == 0 ? b_u : b_v, 6, which == 0 ? -2.0f : -1.0f, n);
         if (which != 0)
-            bernstein_product(h_v, 3, which == 2 ? b_v : b_u, 6, 0, which == 2 ? -2.0f : -1.0f, n);
+            convolve_scaled(h_v, 3, which == 2 ? b_v : b_u, 6, which == 2 ? -2.0f : -1.0f, n);
         float worst = 0.0f;
         for (int k = 0; k < 100; ++k) {
             n[k] /= cube[k];
