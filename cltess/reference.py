@@ -204,23 +204,34 @@ def _bernstein_product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def zs_steps(d_uu: float, d_uv: float, d_vv: float, c: float) -> tuple[float, float]:
     """Steps with ``d_uu du^2 + 2 d_uv du dv + d_vv dv^2 <= c`` and du*dv largest, at most 1.
 
-    The optimum has du/dv = sqrt(d_vv/d_uu) (Lagrange); with s = sqrt(d_uu), t = sqrt(d_vv):
-    du = sqrt(c t / (2 s (s t + d_uv))), dv = sqrt(c s / (2 t (s t + d_uv))), DESIGN.md's
-    formula without its 0 * inf.  Inputs are scaled by their max first; a step that still comes
-    out NaN (underflow) becomes 0, i.e. saturated, never silently coarse.
+    (1, 1) when it meets the bound.  Otherwise the optimum has du/dv = sqrt(d_vv/d_uu)
+    (Lagrange); with s = sqrt(d_uu), t = sqrt(d_vv): du = sqrt(c t / (2 s (s t + d_uv))),
+    dv = sqrt(c s / (2 t (s t + d_uv))), DESIGN.md's formula without its 0 * inf.  Where that
+    optimum lies beyond du = 1 (or dv = 1), the best step pair has du = 1 and the largest dv the
+    bound allows there (a stable quadratic root), not the optimum's dv.  Inputs are scaled by
+    their max first; a step that still comes out NaN (underflow) becomes 0, i.e. saturated, never
+    silently coarse.
     """
-    scale = max(d_uu, d_uv, d_vv)
-    if not scale > 0:
+    if d_uu + 2 * d_uv + d_vv <= c:
         return 1.0, 1.0
+    scale = max(d_uu, d_uv, d_vv)
     a, d, b, c = d_uu / scale, d_uv / scale, d_vv / scale, c / scale
+
+    def largest(quadratic, linear, offset):  # largest x with quadratic x^2 + 2 linear x + offset <= c
+        return (c - offset) / (linear + math.sqrt(linear * linear + quadratic * (c - offset)))
+
     if a > 0 and b > 0:
         s, t = math.sqrt(a), math.sqrt(b)
-        du = math.sqrt(c * t / (2 * s * (s * t + d))) if s * (s * t + d) > 0 else math.inf
-        dv = math.sqrt(c * s / (2 * t * (s * t + d))) if t * (s * t + d) > 0 else math.inf
-    elif a > 0:  # no v curvature: one step in v, solve u alone (stable quadratic root)
-        dv, du = 1.0, c / (d + math.sqrt(d * d + a * c))
+        du = math.sqrt(c * t / (2 * s * (s * t + d)))
+        dv = math.sqrt(c * s / (2 * t * (s * t + d)))
+        if du > 1:
+            du, dv = 1.0, largest(b, d, a)
+        elif dv > 1:
+            du, dv = largest(a, d, b), 1.0
+    elif a > 0:  # no v curvature: one step in v, solve u alone
+        du, dv = largest(a, d, 0.0), 1.0
     elif b > 0:
-        du, dv = 1.0, c / (d + math.sqrt(d * d + b * c))
+        du, dv = 1.0, largest(b, d, 0.0)
     else:  # bilinear twist only
         du = dv = math.sqrt(c / (2 * d))
     return tuple(0.0 if math.isnan(x) else min(x, 1.0) for x in (du, dv))

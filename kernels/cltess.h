@@ -222,27 +222,42 @@ inline float2 edge_uv(int e, int k, int f)
 
 /* --- Zheng-Sederberg steps (DESIGN.md section 2) ---------------------------------------------- */
 
+/* Largest x with quadratic x^2 + 2 linear x + offset <= c (a stable root; offset < c). */
+inline float largest_step(float quadratic, float linear, float offset, float c)
+{
+    return (c - offset) / (linear + sqrt(linear * linear + quadratic * (c - offset)));
+}
+
 /* Steps with d_uu du^2 + 2 d_uv du dv + d_vv dv^2 <= c and du*dv largest, at most 1
- * (reference.zs_steps: the optimum du/dv = sqrt(d_vv/d_uu), written with s = sqrt(d_uu),
- * t = sqrt(d_vv) so that no 0 * inf appears; inputs scaled by their max; NaN -> 0 = saturated). */
+ * (reference.zs_steps): (1, 1) when it meets the bound; else the optimum du/dv = sqrt(d_vv/d_uu),
+ * written with s = sqrt(d_uu), t = sqrt(d_vv) so that no 0 * inf appears, and where it lies
+ * beyond du = 1 (dv = 1) that step is 1 and the other the largest the bound allows; inputs
+ * scaled by their max; NaN -> 0 = saturated. */
 inline float2 zs_steps(float d_uu, float d_uv, float d_vv, float c)
 {
-    float scale = max(max(d_uu, d_uv), d_vv);
-    if (!(scale > 0.0f))
+    if (d_uu + 2.0f * d_uv + d_vv <= c)
         return (float2)(1.0f, 1.0f);
+    float scale = max(max(d_uu, d_uv), d_vv);
     float a = d_uu / scale, d = d_uv / scale, b = d_vv / scale;
     c /= scale;
     float du, dv;
     if (a > 0.0f && b > 0.0f) {
         float s = sqrt(a), t = sqrt(b);
-        du = s * (s * t + d) > 0.0f ? sqrt(c * t / (2.0f * s * (s * t + d))) : INFINITY;
-        dv = t * (s * t + d) > 0.0f ? sqrt(c * s / (2.0f * t * (s * t + d))) : INFINITY;
+        du = sqrt(c * t / (2.0f * s * (s * t + d)));
+        dv = sqrt(c * s / (2.0f * t * (s * t + d)));
+        if (du > 1.0f) {
+            du = 1.0f;
+            dv = largest_step(b, d, a, c);
+        } else if (dv > 1.0f) {
+            du = largest_step(a, d, b, c);
+            dv = 1.0f;
+        }
     } else if (a > 0.0f) {
+        du = largest_step(a, d, 0.0f, c);
         dv = 1.0f;
-        du = c / (d + sqrt(d * d + a * c));
     } else if (b > 0.0f) {
         du = 1.0f;
-        dv = c / (d + sqrt(d * d + b * c));
+        dv = largest_step(b, d, 0.0f, c);
     } else {
         du = dv = sqrt(c / (2.0f * d));
     }

@@ -116,7 +116,18 @@ def test_diagonal_majorant_holds_in_every_direction(rng):
 def test_zs_steps_keep_the_bound_and_are_at_most_one(d_uu, d_uv, d_vv, c):
     du, dv = reference.zs_steps(d_uu, d_uv, d_vv, c)
     assert 0 < du <= 1 and 0 < dv <= 1, (du, dv)
-    assert d_uu * du * du + 2 * d_uv * du * dv + d_vv * dv * dv <= c * (1 + 1e-9)
+    error = d_uu * du * du + 2 * d_uv * du * dv + d_vv * dv * dv
+    assert error <= c * (1 + 1e-9)
+    # Nothing wasted: (1, 1), or on the bound's boundary (no larger step would do).
+    assert (du, dv) == (1.0, 1.0) or error >= c * (1 - 1e-6), (du, dv, error, c)
+
+
+def test_zs_steps_take_the_whole_unit_step_when_the_optimum_lies_beyond_it():
+    """d_uu tiny (a nearly straight u direction): the Lagrange optimum has du >> 1; cut to du = 1,
+    dv must come from the bound at du = 1 (about 0.414 here), not from the optimum (1e-81)."""
+    du, dv = reference.zs_steps(5e-324, 1.0, 1.0, 1.0)
+    assert du == 1.0 and abs(dv - (2 ** 0.5 - 1)) < 1e-12
+    assert reference.zs_steps(5e-324, 0.0, 0.0, 1.0) == (1.0, 1.0)
 
 
 # --- PN triangles: pn_factors derives the control points and the Filip factors ----------------
