@@ -62,12 +62,10 @@ __kernel void zs_factors(__global const float4 *patches, uint num_patches, uint 
     load_patch(patches, p, b);
 
     float3 lo = b[0].xyz / b[0].w, hi = lo;
-    float min_w = b[0].w;
     for (int k = 1; k < 16; ++k) {
         float3 point = b[k].xyz / b[k].w;
         lo = min(lo, point);
         hi = max(hi, point);
-        min_w = min(min_w, b[k].w);
     }
     int culled;
     float tol = patch_tolerance(lo, hi, eps, camera_on, view, frustum, pixels, pixel_size, &culled);
@@ -76,45 +74,7 @@ __kernel void zs_factors(__global const float4 *patches, uint num_patches, uint 
         return;
     }
 
-    /* Translate to the box centre: the bound's r = max |P_ij - c| is not translation-invariant. */
-    float3 centre = 0.5f * (lo + hi);
-    float4 t[16];
-    float r = 0.0f;
-    for (int k = 0; k < 16; ++k) {
-        t[k] = (float4)(b[k].xyz - b[k].w * centre, b[k].w);
-        r = max(r, length(b[k].xyz / b[k].w - centre));
-    }
-
-    /* Maxima of |difference of X| and |difference of w| over the control net
-     * (reference.zs_inverse_steps gives the derivation): .x = X part, .y = w part. */
-    float2 uu = 0.0f, vv = 0.0f, uv = 0.0f, u1 = 0.0f, v1 = 0.0f;
-    for (int j = 0; j < 4; ++j)
-        for (int i = 0; i < 2; ++i) {
-            float4 d = t[4 * j + i + 2] - 2.0f * t[4 * j + i + 1] + t[4 * j + i];
-            uu = max(uu, (float2)(length(d.xyz), fabs(d.w)));
-            float4 e = t[4 * (i + 2) + j] - 2.0f * t[4 * (i + 1) + j] + t[4 * i + j];
-            vv = max(vv, (float2)(length(e.xyz), fabs(e.w)));
-        }
-    for (int j = 0; j < 3; ++j)
-        for (int i = 0; i < 3; ++i) {
-            float4 d = t[4 * (j + 1) + i + 1] - t[4 * (j + 1) + i] - t[4 * j + i + 1] + t[4 * j + i];
-            uv = max(uv, (float2)(length(d.xyz), fabs(d.w)));
-        }
-    for (int j = 0; j < 4; ++j)
-        for (int i = 0; i < 3; ++i) {
-            float4 d = t[4 * j + i + 1] - t[4 * j + i];
-            u1 = max(u1, (float2)(length(d.xyz), fabs(d.w)));
-            float4 e = t[4 * (i + 1) + j] - t[4 * i + j];
-            v1 = max(v1, (float2)(length(e.xyz), fabs(e.w)));
-        }
-    float w_u = 3.0f * u1.y, w_v = 3.0f * v1.y;
-    float slope_u = (3.0f * u1.x + r * w_u) / min_w;  /* bounds |p_u|, hence |l_u| */
-    float slope_v = (3.0f * v1.x + r * w_v) / min_w;
-    float d_uu = 6.0f * uu.x + r * 6.0f * uu.y + 2.0f * w_u * slope_u;
-    float d_vv = 6.0f * vv.x + r * 6.0f * vv.y + 2.0f * w_v * slope_v;
-    float d_uv = 9.0f * uv.x + r * 9.0f * uv.y + w_u * slope_v + w_v * slope_u;
-    float2 step = zs_steps(d_uu, d_uv, d_vv, 8.0f * tol * min_w);
-    float2 inverse = 1.0f / step;
+    float2 inverse = zs_inverse_steps(b, tol);  /* docs/rational-bound.md */
     int saturated = 0;
     int m = edge_factor(inverse.x, max_factor, &saturated);
     int n = edge_factor(inverse.y, max_factor, &saturated);

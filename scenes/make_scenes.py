@@ -3,6 +3,7 @@
     python scenes/make_scenes.py
 
 sphere.bpt      an exact unit sphere: 32 rational bicubic patches (DESIGN.md section 2)
+torus.bpt       an exact torus (radii 3 and 1): 16 rational bicubic patches, one per pair of quarter circles
 table.bpt       a flat 8 x 6 grid of bicubic patches, the tea table's top
 teapots.json    16 teapot instances on a 4 x 4 grid, with a camera
 tea_table.json  the teapot, six cups with saucers and six spoons on the table (332 patches)
@@ -77,6 +78,43 @@ def sphere_patches() -> np.ndarray:
                 q = q[:, :, ::-1]
             patches.append(q)
     return np.concatenate(patches) + 0.0  # + 0.0 turns -0.0 into 0.0
+
+
+QUARTER_TURNS = [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)]  # (cos, sin) of k * 90 degrees, exact
+
+
+def quarter_arc(centre: tuple[float, float], radius: float, k: int) -> np.ndarray:
+    """(3, 3) homogeneous (x w, y w, w) rational quadratic of the circle's quarter from k * 90 to
+    (k + 1) * 90 degrees: ends weight 1, the corner (the two end tangents' meeting point) weight
+    sqrt(2)/2.  Every number is a sum of exact ones, so the end of arc k is bitwise the start of
+    arc k + 1."""
+    (c0, s0), (c1, s1) = QUARTER_TURNS[k % 4], QUARTER_TURNS[(k + 1) % 4]
+    cx, cy = centre
+    w = math.sqrt(2.0) / 2.0
+    points = [(cx + radius * c0, cy + radius * s0, 1.0), (cx + radius * (c0 + c1), cy + radius * (s0 + s1), w),
+              (cx + radius * c1, cy + radius * s1, 1.0)]
+    return np.array([(x * wk, y * wk, wk) for x, y, wk in points]) + 0.0
+
+
+def torus_patches(major: float = 3.0, minor: float = 1.0) -> np.ndarray:
+    """(16, 4, 4, 4) homogeneous patches of the exact torus ((R + r cos v) cos u, (R + r cos v) sin u,
+    r sin v), outward normals.  Patch (a, b) is the tensor product of quarter a of the unit circle
+    (C, along i = u) and quarter b of the tube's circle about (R, 0) in the (rho, z) plane (M, along
+    j = v): ``b_ij = (C_i.x M_j.rho, C_i.y M_j.rho, C_i.w M_j.z, C_i.w M_j.w)``, elevated to
+    bicubic.  Shared boundary rows are products of bitwise equal numbers: bitwise equal."""
+    patches = []
+    for b in range(4):
+        meridian = quarter_arc((major, 0.0), minor, b)
+        for a in range(4):
+            circle = quarter_arc((0.0, 0.0), 1.0, a)
+            net = np.empty((3, 3, 4))  # [j, i, xyzw]
+            for j in range(3):
+                for i in range(3):
+                    rho, z, wv = meridian[j]
+                    cx, cy, wu = circle[i]
+                    net[j, i] = (cx * rho, cy * rho, wu * z, wu * wv)
+            patches.append(elevate_to_cubic(elevate_to_cubic(net, axis=1), axis=0))
+    return np.array(patches) + 0.0
 
 
 def evaluate(patches: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -229,10 +267,11 @@ def tea_table_scene() -> tuple[list[dict], dict]:
 
 def main() -> None:
     write_bpt(HERE / "sphere.bpt", sphere_patches())
+    write_bpt(HERE / "torus.bpt", torus_patches())
     write_bpt(HERE / "table.bpt", grid_patches(**TABLE))
     dump_scene(HERE / "teapots.json", *teapots_scene())
     dump_scene(HERE / "tea_table.json", *tea_table_scene())
-    for name in ("sphere.bpt", "table.bpt", "teapots.json", "tea_table.json"):
+    for name in ("sphere.bpt", "torus.bpt", "table.bpt", "teapots.json", "tea_table.json"):
         print(f"wrote scenes/{name}")
 
 

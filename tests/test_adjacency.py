@@ -54,6 +54,7 @@ def stats(groups: EdgeGroups) -> tuple:
         ("teapot.bpt", (52, 16, 8, 0, 0, 0)),
         ("teacup.bez", (46, 12, 0, 0, 0, 0)),
         ("teaspoon.bez", (28, 8, 0, 0, 0, 0)),
+        ("torus.bpt", (32, 0, 0, 0, 0, 0)),  # closed: 64 patch-edges in 32 pairs
     ],
 )
 def test_shipped_models(name, expected):

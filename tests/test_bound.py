@@ -34,7 +34,7 @@ def test_bound_on_the_teapot(tessellator, eps):
     check_bound(tessellator, load_scene(SCENES / "teapot.bez"), f"teapot eps={eps}", eps=eps)
 
 
-@pytest.mark.parametrize("name", ["teacup.bez", "teaspoon.bez", "sphere.bpt"])
+@pytest.mark.parametrize("name", ["teacup.bez", "teaspoon.bez", "sphere.bpt", "torus.bpt"])
 def test_bound_on_bundled_models(tessellator, name):
     scene = load_scene(SCENES / name)
     size = np.ptp(scene.points.reshape(-1, 3), axis=0).max()
@@ -46,6 +46,12 @@ def test_bound_on_a_closed_grid_with_random_weights(tessellator, rng, eps):
     tess = check_bound(tessellator, closed_torus_grid(rng, 10, 6, noise=0.1), f"random torus grid eps={eps}",
                        eps=eps, max_factor=512)
     assert ((tess.factors[:, 0] != tess.factors[:, 2]) | (tess.factors[:, 1] != tess.factors[:, 3])).any()
+
+
+@pytest.mark.parametrize("eps", [0.2, 0.03])
+def test_bound_on_random_rational_patches(tessellator, rng, eps):
+    scene = Scene(random_patches(rng, 20), np.zeros(20, np.int32), name="random patches")
+    check_bound(tessellator, scene, f"random rational patches eps={eps}", eps=eps, max_factor=4096)
 
 
 def test_bound_in_screen_space_with_culling(tessellator, rng):

@@ -60,12 +60,74 @@ def test_planar_bilinear_patch_gets_factor_one(tessellator):
     assert got.tolist() == [[1, 1, 1, 1]]
 
 
+def second_derivatives(patch, u, v):
+    """|p_uu|, |p_uv|, |p_vv| (N,) of p = X / w at (u, v), by the quotient rule."""
+    def basis(t):
+        s = 1 - t
+        return (reference.bernstein3(t), reference.bernstein3_derivative(t),
+                np.stack([6 * s, 18 * t - 12, 6 - 18 * t, 6 * t], -1))
+    bu, bv = basis(u), basis(v)
+    h = {(a, b): np.einsum("nj,ni,jic->nc", bv[b], bu[a], patch) for a in range(3) for b in range(3)}
+    w = {k: x[:, 3:] for k, x in h.items()}
+    p = h[0, 0][:, :3] / w[0, 0]
+    p_u, p_v = [(h[k][:, :3] - w[k] * p) / w[0, 0] for k in ((1, 0), (0, 1))]
+    p_uu = (h[2, 0][:, :3] - 2 * w[1, 0] * p_u - w[2, 0] * p) / w[0, 0]
+    p_vv = (h[0, 2][:, :3] - 2 * w[0, 1] * p_v - w[0, 2] * p) / w[0, 0]
+    p_uv = (h[1, 1][:, :3] - w[1, 0] * p_v - w[0, 1] * p_u - w[1, 1] * p) / w[0, 0]
+    return [np.linalg.norm(x, axis=1) for x in (p_uu, p_uv, p_vv)]
+
+
+def test_second_derivative_bounds_hold_and_are_tight(rng):
+    """reference.second_derivative_bounds >= |p_ab| sampled densely (a proof may not fail), and
+    within 20% of the sampled maximum on the exact sphere and torus (the bound is not slack; the
+    torus's quarter-circle patches are the loosest, 13-16%)."""
+    from support import SCENES
+    from cltess.formats import load_scene
+
+    t = np.linspace(0, 1, 41)
+    u, v = [x.ravel() for x in np.meshgrid(t, t)]
+    patches = np.concatenate([random_patches(rng, 100), load_scene(SCENES / "sphere.bpt").patches[:8],
+                              load_scene(SCENES / "torus.bpt").patches[:4]])
+    for k, patch in enumerate(patches):
+        bounds = reference.second_derivative_bounds(patch)
+        sampled = [x.max() for x in second_derivatives(patch, u, v)]
+        assert all(s <= b * (1 + 1e-9) for s, b in zip(sampled, bounds)), (k, sampled, bounds)
+        if k >= 100:
+            assert all(b <= 1.2 * s for s, b in zip(sampled, bounds)), (k, sampled, bounds)
+
+
+def test_diagonal_majorant_holds_in_every_direction(rng):
+    """|H_k[h, h]| <= alpha (h_u^2 + rho h_v^2) for every hull point and many directions h, and
+    alpha is attained within 10% on some direction (Lemma 3 of docs/rational-bound.md)."""
+    angle = np.linspace(0, np.pi, 721)
+    h_u, h_v = np.cos(angle), np.sin(angle)
+    for patch in random_patches(rng, 30):
+        hull = reference.second_derivative_hull(patch)
+        for rho in (0.1, 1.0, 7.0):
+            alpha = reference.diagonal_majorant(hull, rho)
+            form = (hull[:, None, 0] * (h_u * h_u)[:, None] + 2 * hull[:, None, 1] * (h_u * h_v)[:, None]
+                    + hull[:, None, 2] * (h_v * h_v)[:, None])  # (K, directions, 3)
+            ratio = np.linalg.norm(form, axis=-1) / (alpha * (h_u * h_u + rho * h_v * h_v))
+            assert ratio.max() <= 1 + 1e-12 and ratio.max() > 0.9, ratio.max()
+
+
 @settings(max_examples=30, deadline=None)
 @given(d_uu=st.floats(0, 1e3), d_uv=st.floats(0, 1e3), d_vv=st.floats(0, 1e3), c=st.floats(1e-6, 1e2))
 def test_zs_steps_keep_the_bound_and_are_at_most_one(d_uu, d_uv, d_vv, c):
     du, dv = reference.zs_steps(d_uu, d_uv, d_vv, c)
     assert 0 < du <= 1 and 0 < dv <= 1, (du, dv)
-    assert d_uu * du * du + 2 * d_uv * du * dv + d_vv * dv * dv <= c * (1 + 1e-9)
+    error = d_uu * du * du + 2 * d_uv * du * dv + d_vv * dv * dv
+    assert error <= c * (1 + 1e-9)
+    # Nothing wasted: (1, 1), or on the bound's boundary (no larger step would do).
+    assert (du, dv) == (1.0, 1.0) or error >= c * (1 - 1e-6), (du, dv, error, c)
+
+
+def test_zs_steps_take_the_whole_unit_step_when_the_optimum_lies_beyond_it():
+    """d_uu tiny (a nearly straight u direction): the Lagrange optimum has du >> 1; cut to du = 1,
+    dv must come from the bound at du = 1 (about 0.414 here), not from the optimum (1e-81)."""
+    du, dv = reference.zs_steps(5e-324, 1.0, 1.0, 1.0)
+    assert du == 1.0 and abs(dv - (2 ** 0.5 - 1)) < 1e-12
+    assert reference.zs_steps(5e-324, 0.0, 0.0, 1.0) == (1.0, 1.0)
 
 
 # --- PN triangles: pn_factors derives the control points and the Filip factors ----------------

@@ -24,7 +24,8 @@ make_scenes = load_make_scenes()
 
 @pytest.mark.parametrize(
     "name, count",
-    [("teapot.bez", 32), ("teapot.bpt", 32), ("teacup.bez", 26), ("teaspoon.bez", 16), ("sphere.bpt", 32), ("table.bpt", 48)],
+    [("teapot.bez", 32), ("teapot.bpt", 32), ("teacup.bez", 26), ("teaspoon.bez", 16), ("sphere.bpt", 32), ("torus.bpt", 16),
+     ("table.bpt", 48)],
 )
 def test_shipped_files(name, count):
     path = str(SCENES / name)
@@ -429,10 +430,11 @@ def test_json_tiny_uniform_scale_is_not_singular(tmp_path):
 def test_make_scenes_is_deterministic(tmp_path):
     """The committed files are what the generator writes."""
     write_bpt(tmp_path / "sphere.bpt", make_scenes.sphere_patches())
+    write_bpt(tmp_path / "torus.bpt", make_scenes.torus_patches())
     write_bpt(tmp_path / "table.bpt", make_scenes.grid_patches(**make_scenes.TABLE))
     make_scenes.dump_scene(tmp_path / "teapots.json", *make_scenes.teapots_scene())
     make_scenes.dump_scene(tmp_path / "tea_table.json", *make_scenes.tea_table_scene())
-    for name in ("sphere.bpt", "table.bpt", "teapots.json", "tea_table.json"):
+    for name in ("sphere.bpt", "torus.bpt", "table.bpt", "teapots.json", "tea_table.json"):
         assert (tmp_path / name).read_bytes() == (SCENES / name).read_bytes(), name
 
 
@@ -458,6 +460,26 @@ def test_sphere_is_exact():
     t_v = make_scenes.evaluate(scene.patches, mid_u, mid_v + h) - make_scenes.evaluate(scene.patches, mid_u, mid_v - h)
     position = make_scenes.evaluate(scene.patches, mid_u, mid_v)
     assert (np.einsum("pkc,pkc->pk", np.cross(t_u, t_v), position) > 0).all()
+
+
+def test_torus_is_exact():
+    """((R + r cos v) cos u, (R + r cos v) sin u, r sin v) with R = 3, r = 1: every point at
+    distance 1 from the core circle, normals outward (away from it)."""
+    scene = load_scene(SCENES / "torus.bpt")
+    rng = np.random.default_rng(8)
+    u, v = rng.random(64), rng.random(64)
+    u[:4], v[:4] = [0, 1, 0, 1], [0, 0, 1, 1]
+    for patches in (make_scenes.torus_patches(), scene.patches):
+        x = make_scenes.evaluate(patches, u, v)
+        core = 3 * x[..., :2] / np.linalg.norm(x[..., :2], axis=-1, keepdims=True)
+        assert np.abs(np.linalg.norm(x - np.concatenate([core, 0 * x[..., 2:]], -1), axis=-1) - 1).max() < 1e-12
+    h = 1e-6
+    mid_u, mid_v = rng.uniform(0.1, 0.9, 16), rng.uniform(0.1, 0.9, 16)
+    t_u = make_scenes.evaluate(scene.patches, mid_u + h, mid_v) - make_scenes.evaluate(scene.patches, mid_u - h, mid_v)
+    t_v = make_scenes.evaluate(scene.patches, mid_u, mid_v + h) - make_scenes.evaluate(scene.patches, mid_u, mid_v - h)
+    x = make_scenes.evaluate(scene.patches, mid_u, mid_v)
+    outward = x - np.concatenate([3 * x[..., :2] / np.linalg.norm(x[..., :2], axis=-1, keepdims=True), 0 * x[..., 2:]], -1)
+    assert (np.einsum("pkc,pkc->pk", np.cross(t_u, t_v), outward) > 0).all()
 
 
 def _in_view(scene) -> bool:

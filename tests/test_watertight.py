@@ -20,7 +20,7 @@ def assert_watertight(tess):
     return mesh
 
 
-@pytest.mark.parametrize("eps", [1e-2, 1e-3, 3e-4])
+@pytest.mark.parametrize("eps", [2e-2, 1e-3, 3e-4])  # each gives neighbours different factors
 def test_sphere_is_watertight(tessellator, eps):
     tess = tessellator.tessellate(load_scene(SCENES / "sphere.bpt"), eps=eps)
     mesh = assert_watertight(tess)
