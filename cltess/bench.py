@@ -499,7 +499,7 @@ def numpy_evaluate(patches: np.ndarray, patch_ids: np.ndarray, uv: np.ndarray,
 
 
 def pn_controls(vertices: np.ndarray, normals: np.ndarray, faces: np.ndarray):
-    """PN triangles of a mesh (DESIGN.md section 3, Vlachos et al.): cubic control points
+    """PN triangles of a mesh (docs/design.md section 3, Vlachos et al.): cubic control points
     (T, 10, 3) in the order b300 b030 b003 b210 b120 b021 b012 b102 b201 b111 and quadratic
     normal controls (T, 6, 3) n200 n020 n002 n110 n011 n101, from the vertex normals."""
     P, N = vertices[faces], normals[faces]  # (T, 3, 3): corner c of each triangle

@@ -173,7 +173,7 @@ inline void load_patch(__global const float4 *patches, uint p, float4 b[16])
 typedef struct {
     __global float *positions;   /* (V, 3) */
     __global float *normals;     /* (V, 3) */
-    __global float *uvs;         /* (V, 2) */
+    __global float *uv;          /* (V, 2) */
     __global int *patch_ids;     /* (V,) */
     __global int *object_ids;    /* (V,) */
 } vertex_out;
@@ -183,7 +183,7 @@ inline void put_vertex(vertex_out out, ulong at, float3 position, float3 normal,
 {
     vstore3(position, at, out.positions);
     vstore3(normal, at, out.normals);
-    vstore2(uv, at, out.uvs);
+    vstore2(uv, at, out.uv);
     out.patch_ids[at] = patch;
     out.object_ids[at] = object;
 }

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..crack.adjacency import crack_free_factors, merge_edge_groups
-from ..kinds import FACTOR_SLOTS, KINDS, PN
+from ..kinds import FACTOR_SLOTS, FLAG_CULLED, FLAG_SATURATED, KINDS
 from ..kinds import kind as kind_named
 from ..patterns import quad_pattern, tri_pattern
 from ..request import Request
@@ -121,8 +121,8 @@ class NumpyBackend:
         vertex_counts, index_counts = np.zeros(base, np.int64), np.zeros(base, np.int64)
         for kind, b, count, _ in parts:
             vertex_counts[b:b + count], index_counts[b:b + count] = kind.pattern.counts(final[b:b + count])
-        stats = {"patches": base, "culled": int(np.count_nonzero(flags & 2)),
-                 "saturated": int(np.count_nonzero(flags & 1))}
+        stats = {"patches": base, "culled": int(np.count_nonzero(flags & FLAG_CULLED)),
+                 "saturated": int(np.count_nonzero(flags & FLAG_SATURATED))}
         return NumpyPlan(scene.name, base, parts, np.concatenate([h.objects for h in inputs]), final,
                          offsets(vertex_counts), offsets(index_counts), stats)
 

@@ -13,7 +13,7 @@ from .tolerance import box_tolerances
 def pn_second_derivative_bounds(controls: np.ndarray) -> np.ndarray:
     """(T, 3, 3) bounds D[a, b] >= sup |D_{d_a} D_{d_b} b| over the triangle: 6 times the largest
     norm of the three control points of (Delta_a Delta_b b), Delta_e b_I = b_{I+e_{e+1}} - b_{I+e_e}
-    (DESIGN.md section 3)."""
+    (docs/design.md section 3)."""
     b = np.asarray(controls, float)[:, :10, :3]
     bounds = np.zeros((len(b), 3, 3))
     for a in range(3):

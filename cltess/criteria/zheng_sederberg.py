@@ -11,7 +11,7 @@ from .base import DEFAULT_MAX_FACTOR
 
 def zs_factors(patches: np.ndarray, eps: np.ndarray, culled: np.ndarray | None = None,
                max_factor: int = DEFAULT_MAX_FACTOR) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Zheng-Sederberg factors (DESIGN.md section 2; CudaTess section 3, "Tessellation factors").
+    """Zheng-Sederberg factors (docs/design.md section 2; CudaTess section 3, "Tessellation factors").
 
     Returns (factors (P, 4) int32 ordered by edge, unclamped (P, 2) float64 = (1/du, 1/dv),
     saturated (P,) bool).  Culled patches get factor 0 and are never saturated.
@@ -47,7 +47,7 @@ def zs_inverse_steps(patch: np.ndarray, eps: float) -> tuple[float, float]:
     bounds come from the control-point differences (6 and 9 for second, 3 for first).  With
     equal weights the w terms vanish and this is the paper's bound exactly; the paper's
     ``max(r - eps, 0)`` bounds the distance to the projective interpolant L_X / L_w instead,
-    which is not the same (u, v) when the weights differ (DESIGN.md section 2).
+    which is not the same (u, v) when the weights differ (docs/design.md section 2).
     """
     points = patch[..., :3] / patch[..., 3:]
     centre = (points.min(axis=(0, 1)) + points.max(axis=(0, 1))) / 2
@@ -80,8 +80,8 @@ def zs_steps(d_uu: float, d_uv: float, d_vv: float, c: float) -> tuple[float, fl
     """Steps with ``d_uu du^2 + 2 d_uv du dv + d_vv dv^2 <= c`` and du*dv largest, at most 1.
 
     The optimum has du/dv = sqrt(d_vv/d_uu) (Lagrange); with s = sqrt(d_uu), t = sqrt(d_vv):
-    du = sqrt(c t / (2 s (s t + d_uv))), dv = sqrt(c s / (2 t (s t + d_uv))), DESIGN.md's
-    formula without its 0 * inf.  Inputs are scaled by their max first; a step that still comes
+    du = sqrt(c t / (2 s (s t + d_uv))), dv = sqrt(c s / (2 t (s t + d_uv))) (docs/design.md
+    section 2) without its 0 * inf.  Inputs are scaled by their max first; a step that still comes
     out NaN (underflow) becomes 0, i.e. saturated, never silently coarse.
     """
     scale = max(d_uu, d_uv, d_vv)

@@ -15,6 +15,8 @@ from ..scene import Scene
 #: Factors per patch in the shared (P, 4) array (kernels/common.h FACTOR_SLOTS); a kind uses
 #: its first ``edges``, the rest are 0.
 FACTOR_SLOTS = 4
+#: Stage 1's flags per patch (kernels/common.h FLAG_*).
+FLAG_SATURATED, FLAG_CULLED, FLAG_FOLDED = 1, 2, 4
 
 
 @dataclass
@@ -37,14 +39,17 @@ class PatchKind:
     """One patch type (a plug-in; registry ``cltess.kinds.KINDS``).
 
     name:    its name ("bezier", "pn").
+    domain:  "quad" or "tri": the patterns it can use.
     edges:   boundary curves per patch (at most FACTOR_SLOTS).
     header:  its device header under kernels/ (the kind contract of docs/extending.md).
     pattern: its default pattern (a ``cltess.patterns.Pattern`` of its domain).
-    surface: its NumPy surface module (``cltess.surfaces.<kind>``), whose ``evaluate(controls,
-             u, v) -> (positions, normals)`` mirrors the kernels' evaluation.
+    surface: its NumPy surface module (``cltess.surfaces.<kind>``): ``evaluate(controls, u, v)
+             -> (positions, normals)`` of one patch and ``surface_points(controls, ids, u, v)``
+             of many, the mirrors of the kernels' evaluation.
     """
 
     name = ""
+    domain = ""
     edges = 0
     header = ""
     pattern: Pattern

@@ -8,11 +8,12 @@ from ..criteria.zheng_sederberg import zs_factors
 from ..crack.adjacency import edge_groups
 from ..patterns import QUAD_TRANSITION
 from ..surfaces import bezier as surface
-from .base import KindInput, PatchKind
+from .base import FLAG_CULLED, FLAG_FOLDED, KindInput, PatchKind
 
 
 class BezierKind(PatchKind):
     name = "bezier"
+    domain = "quad"
     edges = 4
     header = "kinds/bezier.h"
     pattern = QUAD_TRANSITION
@@ -30,7 +31,7 @@ class BezierKind(PatchKind):
         points = (patches[..., :3] / patches[..., 3:]).reshape(len(patches), -1, 3)
         eps, culled = tolerance.reference(points.min(axis=1), points.max(axis=1))
         factors, _, saturated = zs_factors(patches, eps, culled, max_factor)
-        flags = np.where(culled, 2, saturated.astype(np.int32)).astype(np.int32)
+        flags = np.where(culled, FLAG_CULLED, saturated.astype(np.int32)).astype(np.int32)
         return patches, factors, flags
 
 

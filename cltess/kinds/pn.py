@@ -20,7 +20,7 @@ from ..patterns import TRI_TRANSITION
 from ..scene import weld_positions
 from ..surfaces import pn as surface
 from ..surfaces.pn import pn_control_points, pn_folded
-from .base import KindInput, PatchKind
+from .base import FLAG_CULLED, FLAG_FOLDED, KindInput, PatchKind
 
 #: How ``pn_edge_normals`` treats a sharp edge (different normals on its two sides).
 SHARP_EDGE_MODES = ("straight", "average", "keep")
@@ -95,6 +95,7 @@ def pn_edge_normals(normals: np.ndarray, groups: EdgeGroups, sharp: np.ndarray, 
 
 class PNKind(PatchKind):
     name = "pn"
+    domain = "tri"
     edges = 3
     header = "kinds/pn.h"
     pattern = TRI_TRANSITION
@@ -131,7 +132,7 @@ class PNKind(PatchKind):
         points = controls[:, :10, :3]
         eps, culled = tolerance.reference(points.min(axis=1), points.max(axis=1))
         factors, _, saturated = pn_factors(controls, eps, culled, max_factor)
-        flags = np.where(pn_folded(controls), 4, np.where(culled, 2, saturated.astype(np.int32)))
+        flags = np.where(pn_folded(controls), FLAG_FOLDED, np.where(culled, FLAG_CULLED, saturated.astype(np.int32)))
         return controls, factors, flags.astype(np.int32)
 
 

@@ -62,7 +62,7 @@ def limit_normal(patch, u, v, b, b_u, b_v) -> np.ndarray:
     """D_d(T_u x T_v) = D_d T_u x T_v + T_u x D_d T_v, d = (1/2 - u, 1/2 - v), at (u, v) (N,).
 
     With D_d p = (d_u T_u + d_v T_v) / B.w.  Where T_u x T_v vanishes on a collapsed edge this is
-    the direction the normal tends to (DESIGN.md section 2, "the next-order term").
+    the direction the normal tends to (docs/design.md section 2, "the next-order term").
     patch: one (4, 4, 4) patch, or (N, 4, 4, 4), one per sample."""
     patch = np.broadcast_to(patch, (len(u), 4, 4, 4))
     lin_u, lin_v = np.stack([1 - u, u], -1), np.stack([1 - v, v], -1)

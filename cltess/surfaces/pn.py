@@ -111,3 +111,8 @@ def pn_surface_points(controls: np.ndarray, patch_ids: np.ndarray, u: np.ndarray
     """Positions (N, 3) of many PN triangles: sample n is triangle ``patch_ids[n]`` at (u[n], v[n])."""
     cubic, _ = _pn_basis(np.asarray(u, float), np.asarray(v, float))
     return np.einsum("nk,nkc->nc", cubic, np.asarray(controls, float)[patch_ids, :10, :3])
+
+
+#: The surface interface every kind's module offers (cltess.kinds.base.PatchKind.surface).
+evaluate = pn_evaluate
+surface_points = pn_surface_points

@@ -8,14 +8,14 @@ __kernel void vertices(__global const float4 *controls, __global const int4 *fac
                        __global const ulong *vertex_offsets, __global const int *patch_objects,
                        uint first_patch, uint num_patches, uint patch_base, ulong vertex_base,
                        int forward_differencing,
-                       __global float *positions, __global float *normals, __global float *uvs,
+                       __global float *positions, __global float *normals, __global float *uv,
                        __global int *patch_ids, __global int *object_ids)
 {
     uint p;
     int4 f;
     if (!batch_patch(first_patch, num_patches, factors, &p, &f))
         return;
-    vertex_out out = {positions, normals, uvs, patch_ids, object_ids};
+    vertex_out out = {positions, normals, uv, patch_ids, object_ids};
     int object = patch_objects[p];
     kind_patch patch;
     kind_load(controls, p - patch_base, &patch);

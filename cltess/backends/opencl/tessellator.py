@@ -28,7 +28,7 @@ import pyopencl.array as cl_array
 from ...criteria.tolerance import ObjectSpace, ScreenSpace
 from ...crack.adjacency import merge_edge_groups
 from ...device import pick_device
-from ...kinds import BEZIER, FACTOR_SLOTS, KINDS, PN, PatchKind
+from ...kinds import BEZIER, FACTOR_SLOTS, FLAG_CULLED, FLAG_SATURATED, KINDS, PN, PatchKind
 from ...kinds import kind as kind_named
 from ...patterns import Pattern
 from ...request import Request
@@ -145,8 +145,8 @@ class Tessellator:
         flag_values = flags.get()
         stats = {
             "patches": count,
-            "culled": int(np.count_nonzero(flag_values & 2)),
-            "saturated": int(np.count_nonzero(flag_values & 1)),
+            "culled": int(np.count_nonzero(flag_values & FLAG_CULLED)),
+            "saturated": int(np.count_nonzero(flag_values & FLAG_SATURATED)),
             "vertices": num_vertices,
             "triangles": num_indices // 3,
             "shared_edges": sum(host.groups.shared for host in inputs),
