@@ -176,32 +176,34 @@ inline int4 kind_factors(__global const float4 *source, __global float4 *control
 
 /* Stages 4: the patch as evaluated, about its own centre (centred_patch). */
 typedef struct {
-    float4 b[16];    /* as given: boundary points come from its edges, bitwise like the neighbour's */
-    float4 t[16];    /* moved to its centre: normals and interior points */
+    float4 edges[4][4];  /* its boundary curves as given: points on them bitwise like the neighbour's */
+    float4 t[16];        /* the patch moved to its centre: normals and interior points */
     float3 centre;
 } kind_patch;
 
 inline void kind_load(__global const float4 *controls, uint p, kind_patch *patch)
 {
-    load_patch(controls, p, patch->b);
-    patch->centre = centred_patch(patch->b, patch->t);
+    float4 b[16];
+    load_patch(controls, p, b);
+    for (int e = 0; e < 4; ++e)
+        edge_controls(b, e, patch->edges[e]);
+    patch->centre = centred_patch(b, patch->t);
 }
 
 /* Position of point t of edge e, canonical from the edge's own control points. */
 inline float3 kind_boundary_point(const kind_patch *patch, int e, edge_param t)
 {
-    float4 c[4];
-    edge_controls(patch->b, e, c);
-    float4 h = boundary_point(c, t);
+    float4 h = boundary_point(patch->edges[e], t);
     return h.xyz / h.w;
 }
 
-/* Direct evaluation at x = (u, v, 0). */
+/* Direct evaluation at x = (u, v, 0) (position 0: the normal only). */
 inline void kind_eval(const kind_patch *patch, float3 x, float3 *position, float3 *normal)
 {
     float4 s, s_u, s_v;
     surface_eval(patch->t, x.x, x.y, &s, &s_u, &s_v);
-    *position = s.xyz / s.w + patch->centre;
+    if (position)
+        *position = s.xyz / s.w + patch->centre;
     *normal = surface_normal(patch->t, x.x, x.y, s, s_u, s_v);
 }
 

@@ -168,26 +168,28 @@ inline int4 kind_factors(__global const float4 *source, __global float4 *control
 
 typedef struct {
     float4 b[16];
+    float4 edges[3][4];  /* its boundary curves, corner e to corner e+1 */
 } kind_patch;
 
 inline void kind_load(__global const float4 *controls, uint p, kind_patch *patch)
 {
     load_patch(controls, p, patch->b);
+    for (int e = 0; e < 3; ++e)
+        pn_edge_curve(patch->b, e, patch->edges[e]);
 }
 
 /* Position of point t of edge e: the edge's own curve, placed symmetrically, so the neighbour's
  * is bitwise the same; corners exact. */
 inline float3 kind_boundary_point(const kind_patch *patch, int e, edge_param t)
 {
-    float4 c[4];
-    pn_edge_curve(patch->b, e, c);
-    return boundary_point(c, t).xyz;
+    return boundary_point(patch->edges[e], t).xyz;
 }
 
-/* Direct evaluation at barycentric x. */
+/* Direct evaluation at barycentric x (position 0: the normal only). */
 inline void kind_eval(const kind_patch *patch, float3 x, float3 *position, float3 *normal)
 {
-    *position = pn_position(patch->b, x);
+    if (position)
+        *position = pn_position(patch->b, x);
     *normal = pn_unit_normal(patch->b, pn_normal_field(patch->b, x));
 }
 

@@ -54,28 +54,42 @@ inline float3 pattern_row_point(int4 f, int j, int i)
 
 /* --- the triangles ---------------------------------------------------------------------------- */
 
+/* The A x B grid of a patch, computed once: its factors and core. */
+typedef struct {
+    int4 f;
+    int2 core;
+    int uniform;
+} pattern_grid;
+
+inline pattern_grid quad_grid(int4 f)
+{
+    pattern_grid g;
+    g.f = f;
+    g.core = quad_core(f, &g.uniform);
+    return g;
+}
+
 /* Local number of grid point (i, j) of the A x B grid: on the boundary a ring point, else an
  * inner point. */
-inline uint pattern_grid_index(int4 f, int2 point)
+inline uint pattern_grid_index(pattern_grid g, int2 point)
 {
-    int uniform;
-    int2 core = quad_core(f, &uniform);
+    int4 f = g.f;
     int i = point.x, j = point.y;
     if (j == 0) return ring_index(f, 0, i);
-    if (i == core.x) return ring_index(f, 1, j);
-    if (j == core.y) return ring_index(f, 2, core.x - i);
-    if (i == 0) return ring_index(f, 3, core.y - j);
-    return (uint)(f.s0 + f.s1 + f.s2 + f.s3 + (j - 1) * (core.x - 1) + (i - 1));
+    if (i == g.core.x) return ring_index(f, 1, j);
+    if (j == g.core.y) return ring_index(f, 2, g.core.x - i);
+    if (i == 0) return ring_index(f, 3, g.core.y - j);
+    return (uint)(f.s0 + f.s1 + f.s2 + f.s3 + (j - 1) * (g.core.x - 1) + (i - 1));
 }
 
 #include "patterns/stitch.h"
 
-inline void grid_cells(__global uint *out, uint *count, uint base, int4 f, int i0, int i1, int j0, int j1)
+inline void grid_cells(__global uint *out, uint *count, uint base, pattern_grid g, int i0, int i1, int j0, int j1)
 {
     for (int j = j0; j < j1; ++j)
         for (int i = i0; i < i1; ++i) {
-            uint a = pattern_grid_index(f, (int2)(i, j)), b = pattern_grid_index(f, (int2)(i + 1, j));
-            uint c = pattern_grid_index(f, (int2)(i + 1, j + 1)), d = pattern_grid_index(f, (int2)(i, j + 1));
+            uint a = pattern_grid_index(g, (int2)(i, j)), b = pattern_grid_index(g, (int2)(i + 1, j));
+            uint c = pattern_grid_index(g, (int2)(i + 1, j + 1)), d = pattern_grid_index(g, (int2)(i, j + 1));
             put_triangle(out, count, base, a, b, c);
             put_triangle(out, count, base, a, c, d);
         }
@@ -87,24 +101,27 @@ inline void grid_cells(__global uint *out, uint *count, uint base, int4 f, int i
 inline uint pattern_primitives(int4 f, __global uint *out, uint base)
 {
     uint count = 0;
-    int uniform;
     if (f.s0 <= 0)
         return 0;
-    int2 core = quad_core(f, &uniform);
-    if (uniform) {
-        grid_cells(out, &count, base, f, 0, core.x, 0, core.y);
+    pattern_grid g = quad_grid(f);
+    int a = g.core.x, b = g.core.y;
+    if (g.uniform) {
+        grid_cells(out, &count, base, g, 0, a, 0, b);
         return count;
     }
-    grid_cells(out, &count, base, f, 1, core.x - 1, 1, core.y - 1);
+    grid_cells(out, &count, base, g, 1, a - 1, 1, b - 1);
     /* Edge e's inner polyline runs counter-clockwise along the inner grid's boundary, its point k
      * at (k + 1) / along of the edge: segment midpoints at (2k + 3) / (2 along). */
-    int a = core.x, b = core.y;
-    int2 start[4] = {(int2)(1, 1), (int2)(a - 1, 1), (int2)(a - 1, b - 1), (int2)(1, b - 1)};
-    int2 step[4] = {(int2)(1, 0), (int2)(0, 1), (int2)(-1, 0), (int2)(0, -1)};
     for (int e = 0; e < 4; ++e) {
         int along = (e % 2 == 0) ? a : b;
-        stitch_row row = {start[e], step[e], 0, along - 2, along, 3};
-        stitch_strip(out, &count, base, f, e, row);
+        stitch_row row;
+        row.start = e == 0 ? (int2)(1, 1) : e == 1 ? (int2)(a - 1, 1) : e == 2 ? (int2)(a - 1, b - 1) : (int2)(1, b - 1);
+        row.step = e == 0 ? (int2)(1, 0) : e == 1 ? (int2)(0, 1) : e == 2 ? (int2)(-1, 0) : (int2)(0, -1);
+        row.first = 0;
+        row.last = along - 2;
+        row.along = along;
+        row.lead = 3;
+        stitch_strip(out, &count, base, g, e, row);
     }
     return count;
 }

@@ -38,11 +38,18 @@ inline float3 pattern_row_point(int4 f, int j, int i)
 
 /* --- the triangles ---------------------------------------------------------------------------- */
 
+/* The factor-N grid of a patch, computed once: its factors and N. */
+typedef struct {
+    int4 f;
+    int n;
+} pattern_grid;
+
 /* Local number of grid point (i, j, n-i-j) of the factor-n grid: a corner, a point of an edge
  * whose factor is n (the pattern uses no other boundary grid points), or an interior point. */
-inline uint pattern_grid_index(int4 f, int2 point)
+inline uint pattern_grid_index(pattern_grid g, int2 point)
 {
-    int n = tri_core(f), i = point.x, j = point.y, k = n - i - j;
+    int4 f = g.f;
+    int n = g.n, i = point.x, j = point.y, k = n - i - j;
     if (i == n) return 0;
     if (j == n) return (uint)f.s0;
     if (k == n) return (uint)(f.s0 + f.s1);
@@ -79,6 +86,7 @@ inline uint pattern_primitives(int4 f, __global uint *out, uint base)
     if (f.s0 <= 0)
         return 0;
     int n = tri_core(f);
+    pattern_grid g = {f, n};
     int t[3] = {f.s0 < n, f.s1 < n, f.s2 < n};
     /* The core: the regular grid of factor m on the points whose coordinate (e+2)%3, which is 0
      * on edge e, is at least t[e]; up and down triangles, counter-clockwise. */
@@ -86,18 +94,18 @@ inline uint pattern_primitives(int4 f, __global uint *out, uint base)
     for (int j = 0; j < m; ++j)
         for (int i = 0; i + j < m; ++i) {
             int a = t[1] + i, b = t[2] + j;  /* grid point (a, b, n-a-b) */
-            put_triangle(out, &count, base, pattern_grid_index(f, (int2)(a + 1, b)),
-                         pattern_grid_index(f, (int2)(a, b + 1)), pattern_grid_index(f, (int2)(a, b)));
+            put_triangle(out, &count, base, pattern_grid_index(g, (int2)(a + 1, b)),
+                         pattern_grid_index(g, (int2)(a, b + 1)), pattern_grid_index(g, (int2)(a, b)));
             if (i + j < m - 1)
-                put_triangle(out, &count, base, pattern_grid_index(f, (int2)(a + 1, b)),
-                             pattern_grid_index(f, (int2)(a + 1, b + 1)), pattern_grid_index(f, (int2)(a, b + 1)));
+                put_triangle(out, &count, base, pattern_grid_index(g, (int2)(a + 1, b)),
+                             pattern_grid_index(g, (int2)(a + 1, b + 1)), pattern_grid_index(g, (int2)(a, b + 1)));
         }
     for (int e = 0; e < 3; ++e) {
         if (!t[e])
             continue;
         int2 start = tri_row_point(n, e, 0);
         stitch_row row = {start, tri_row_point(n, e, 1) - start, t[(e + 2) % 3], n - 1 - t[(e + 1) % 3], n, 2};
-        stitch_strip(out, &count, base, f, e, row);
+        stitch_strip(out, &count, base, g, e, row);
     }
     return count;
 }

@@ -26,23 +26,27 @@ __kernel void vertices(__global const float4 *controls, __global const int4 *fac
         for (int k = 0; k < factor_of(f, e); ++k) {
             edge_param t = pattern_ring_param(f, e, k);
             float3 x = pattern_edge_point(e, t);
-            kind_eval(&patch, x, &position, &normal);  /* the normal; the position is the edge's */
+            kind_eval(&patch, x, 0, &normal);  /* the normal; the position is the edge's */
             put_vertex(out, at++, kind_boundary_point(&patch, e, t), normal, x.xy, p, object);
         }
 
     int rows = pattern_rows(f);
     for (int j = 1; j <= rows; ++j) {
         int steps = pattern_row(f, j);
-        kind_row row;
-        if (forward_differencing)
+        if (forward_differencing) {
+            kind_row row;
             kind_row_begin(&patch, pattern_row_point(f, j, 0), pattern_row_point(f, j, steps), steps, &row);
-        for (int i = 1; i < steps; ++i) {
-            float3 x = pattern_row_point(f, j, i);
-            if (forward_differencing)
+            for (int i = 1; i < steps; ++i) {
+                float3 x = pattern_row_point(f, j, i);
                 kind_row_next(&patch, &row, x, &position, &normal);
-            else
+                put_vertex(out, at++, position, normal, x.xy, p, object);
+            }
+        } else {
+            for (int i = 1; i < steps; ++i) {
+                float3 x = pattern_row_point(f, j, i);
                 kind_eval(&patch, x, &position, &normal);
-            put_vertex(out, at++, position, normal, x.xy, p, object);
+                put_vertex(out, at++, position, normal, x.xy, p, object);
+            }
         }
     }
 }
