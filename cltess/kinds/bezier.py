@@ -8,7 +8,7 @@ from ..criteria.zheng_sederberg import zs_factors
 from ..crack.adjacency import edge_groups
 from ..patterns import QUAD_TRANSITION
 from ..surfaces import bezier as surface
-from .base import FLAG_CULLED, FLAG_FOLDED, KindInput, PatchKind
+from .base import FLAG_CULLED, KindInput, PatchKind
 
 
 class BezierKind(PatchKind):

@@ -46,13 +46,13 @@ def evaluate(patch: np.ndarray, u, v) -> tuple[np.ndarray, np.ndarray]:
     u, v = np.atleast_1d(np.asarray(u, float)), np.atleast_1d(np.asarray(v, float))
     b, b_u, b_v = homogeneous_and_derivatives(patch, u, v)
     position = b[:, :3] / b[:, 3:]
-    normal = _normal(b, b_u, b_v)
-    bad = ~_normal_ok(normal, b, b_u, b_v)
+    normal = tangent_cross(b, b_u, b_v)
+    bad = ~normal_ok(normal, b, b_u, b_v)
     if bad.any():
         limit = limit_normal(patch, u[bad], v[bad], b[bad], b_u[bad], b_v[bad])
         stronger = (limit * limit).sum(1) > (normal[bad] * normal[bad]).sum(1)
         us, vs = u[bad] + NORMAL_SHIFT * (0.5 - u[bad]), v[bad] + NORMAL_SHIFT * (0.5 - v[bad])
-        inside = _normal(*homogeneous_and_derivatives(patch, us, vs))
+        inside = tangent_cross(*homogeneous_and_derivatives(patch, us, vs))
         normal[bad] = np.where(stronger[:, None], limit, inside)
     length = np.linalg.norm(normal, axis=1, keepdims=True)
     return position, np.where(length > 0, normal / np.where(length > 0, length, 1), [0.0, 0.0, 1.0])
@@ -95,14 +95,16 @@ NORMAL_SHIFT = 1.0e-3  # the last resort: how far towards the domain centre a no
 NORMAL_DEGENERATE = 1.0e-3  # |T_u x T_v| below this times |T_u|^2 + |T_v|^2: use limit_normal
 
 
-def _normal(b, b_u, b_v):
+def tangent_cross(b, b_u, b_v):
+    """Unnormalised T_u x T_v (N, 3) from B, B_u, B_v (N, 4) (kernels/kinds/bezier.h tangent_cross)."""
     p = b[:, :3] / b[:, 3:]
     t_u = b_u[:, :3] - b_u[:, 3:] * p
     t_v = b_v[:, :3] - b_v[:, 3:] * p
     return np.cross(t_u, t_v)
 
 
-def _normal_ok(normal, b, b_u, b_v):
+def normal_ok(normal, b, b_u, b_v):
+    """Where T_u x T_v is not (nearly) vanishing: |n|^2 > NORMAL_DEGENERATE^2 (|T_u|^2 + |T_v|^2)^2."""
     p = b[:, :3] / b[:, 3:]
     t_u = b_u[:, :3] - b_u[:, 3:] * p
     t_v = b_v[:, :3] - b_v[:, 3:] * p
