@@ -42,3 +42,21 @@ def test_the_kernels_vertex_record_is_vertex_record():
     assert arguments[-len(VERTEX_RECORD):] == fields  # the kernel's outputs, in the record's order
     assert [name for name, _, _ in VERTEX_RECORD] == list(Tessellation.__dataclass_fields__)[:len(VERTEX_RECORD)]
     assert BYTES_PER_VERTEX == 3 * 4 + 3 * 4 + 2 * 4 + 4 + 4
+
+
+def test_the_engine_never_imports_the_reference():
+    """cltess.reference only gathers the NumPy mirrors for tests and scripts: no module of the
+    package imports it (the mirrors live by what varies: surfaces, patterns, criteria, crack)."""
+    import ast
+    from pathlib import Path
+
+    import cltess
+
+    package = Path(cltess.__file__).parent
+    for path in package.rglob("*.py"):
+        if path.name == "reference.py":
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            names = [a.name for a in node.names] if isinstance(node, (ast.Import, ast.ImportFrom)) else []
+            module = node.module or "" if isinstance(node, ast.ImportFrom) else ""
+            assert "reference" not in module.split(".") and not any("reference" in n.split(".") for n in names), path
