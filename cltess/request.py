@@ -22,7 +22,8 @@ class Request:
     forward_differencing: stage 4 walks the interior rows by forward differences (else direct).
     sharp_edges:    what a mesh edge with different normals on its sides becomes ("straight",
                     "average" or "keep"; cltess.kinds.pn.pn_edge_normals); other kinds ignore it.
-    pattern:        a registered pattern name for every kind, or None for each kind's own.
+    pattern:        a registered pattern name for the kinds of its domain (the others keep their
+                    own), or None for each kind's own.
     """
 
     tolerance: ObjectSpace | ScreenSpace
@@ -66,5 +67,7 @@ class Request:
             raise ValueError(f"{scene.name}: the scene has no patches")
 
     def pattern_for(self, kind):
-        """The pattern a kind is tessellated with."""
-        return kind.pattern if self.pattern is None else PATTERNS[self.pattern]
+        """The pattern a kind is tessellated with: the requested one where its domain is the
+        kind's, else the kind's own."""
+        chosen = PATTERNS.get(self.pattern) if self.pattern is not None else None
+        return chosen if chosen is not None and chosen.domain == kind.domain else kind.pattern

@@ -70,8 +70,8 @@ def pn_tessellate(controls: np.ndarray, factors: np.ndarray, object_ids: np.ndar
 
 @dataclass
 class NumpyPlan:
-    """Stages 1-3 of the NumPy backend: per kind (kind, base, count, controls), the final
-    factors and the offsets, all host arrays."""
+    """Stages 1-3 of the NumPy backend: per kind (kind, pattern, base, count, controls), the
+    final factors and the offsets, all host arrays."""
 
     name: str
     num_patches: int
@@ -109,18 +109,18 @@ class NumpyBackend:
                 continue
             host = kind.prepare(scene, request.sharp_edges)
             controls, f, fl = kind.reference_factors(host.source, request.tolerance_for(scene), request.max_factor)
-            parts.append((kind, base, count, controls))
+            parts.append((kind, request.pattern_for(kind), base, count, controls))
             inputs.append(host)
             factors.append(f)
             flags.append(fl)
             base += count
         factors, flags = np.concatenate(factors), np.concatenate(flags)
-        groups = merge_edge_groups([(host.groups, kind.edges, b) for host, (kind, b, _, _) in zip(inputs, parts)],
+        groups = merge_edge_groups([(host.groups, kind.edges, b) for host, (kind, _, b, _, _) in zip(inputs, parts)],
                                    base, FACTOR_SLOTS)
         final = crack_free_factors(factors, groups.group_of, groups.group_start, groups.members)
         vertex_counts, index_counts = np.zeros(base, np.int64), np.zeros(base, np.int64)
-        for kind, b, count, _ in parts:
-            vertex_counts[b:b + count], index_counts[b:b + count] = kind.pattern.counts(final[b:b + count])
+        for _, pattern, b, count, _ in parts:
+            vertex_counts[b:b + count], index_counts[b:b + count] = pattern.counts(final[b:b + count])
         stats = {"patches": base, "culled": int(np.count_nonzero(flags & FLAG_CULLED)),
                  "saturated": int(np.count_nonzero(flags & FLAG_SATURATED))}
         return NumpyPlan(scene.name, base, parts, np.concatenate([h.objects for h in inputs]), final,
@@ -129,12 +129,12 @@ class NumpyBackend:
     def emit(self, plan: NumpyPlan, first: int, last: int, request: Request | None = None) -> Tessellation:
         started = time.perf_counter()
         pieces = []
-        for kind, base, count, controls in plan.parts:
+        for kind, pattern, base, count, controls in plan.parts:
             lo, hi = max(first, base), min(last, base + count)
             if lo >= hi:
                 continue
             out = tessellate(controls[lo - base:hi - base], plan.factors[lo:hi], plan.objects[lo:hi],
-                             kind.pattern.layout, kind.surface.evaluate, lo)
+                             pattern.layout, kind.surface.evaluate, lo)
             out["triangles"] = out["triangles"] + plan.vertex_offsets[lo]
             pieces.append(out)
         arrays = {name: np.concatenate([p[name] for p in pieces]).astype(dtype).reshape((-1, *shape))
