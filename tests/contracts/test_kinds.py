@@ -20,10 +20,10 @@ def kind(request):
 
 def device_factors(tessellator, kind, source, eps, max_factor=64):
     count = len(source)
-    data = tessellator._upload(kind, source)
+    data = tessellator.upload(kind, source)
     factors = cl_array.empty(tessellator.queue, (count, 4), np.int32)
     flags = cl_array.empty(tessellator.queue, count, np.int32)
-    tessellator._factors(kind, data, ObjectSpace(eps), max_factor, factors, flags, 0)
+    tessellator.stage_factors_of(kind, data, ObjectSpace(eps), max_factor, factors, flags, 0)
     return data, factors, flags
 
 

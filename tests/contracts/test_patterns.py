@@ -5,6 +5,7 @@ import numpy as np
 import pyopencl.array as cl_array
 import pytest
 
+from cltess.criteria import ObjectSpace
 from cltess.patterns import PATTERNS
 from support.factors import random_pattern_factors
 from support.kinds import kind_for, random_source
@@ -43,10 +44,9 @@ def test_vertex_layout_equals_the_mirror(tessellator, rng, pattern, fd):
     kind = kind_for(pattern)
     factors = random_pattern_factors(rng, pattern, 200)
     count = len(factors)
-    data = tessellator._upload(kind, random_source(rng, kind, count))
+    data = tessellator.upload(kind, random_source(rng, kind, count))
     scratch = cl_array.empty(tessellator.queue, (count, 4), np.int32), cl_array.empty(tessellator.queue, count, np.int32)
-    from cltess.criteria import ObjectSpace
-    tessellator._factors(kind, data, ObjectSpace(0.1), 64, *scratch, 0)  # the kind's stage-4 input
+    tessellator.stage_factors_of(kind, data, ObjectSpace(0.1), 64, *scratch)  # the kind's stage-4 input
     device_factors = cl_array.to_device(tessellator.queue, factors)
     vertex_offsets, _, _ = tessellator.stage_counts(device_factors, [(pattern, 0, count)])
     total = int(vertex_offsets[count].get())

@@ -121,7 +121,7 @@ class Tessellator:
         for kind in kinds:
             count = kind.count(scene)
             host = scene.prepared((kind.name, sharp_edges), lambda: kind.prepare(scene, sharp_edges))
-            parts.append(PlanPart(kind, request.pattern_for(kind), base, count, self._upload(kind, host.source)))
+            parts.append(PlanPart(kind, request.pattern_for(kind), base, count, self.upload(kind, host.source)))
             inputs.append(host)
             base += count
         count = base
@@ -130,8 +130,8 @@ class Tessellator:
         flags = cl_array.empty(self.queue, count, np.int32)
         events = {"factors": []}
         for part in parts:
-            events["factors"] += self._factors(part.kind, part.data, tolerance, request.max_factor,
-                                               factors, flags, part.base)
+            events["factors"] += self.stage_factors_of(part.kind, part.data, tolerance, request.max_factor,
+                                                       factors, flags, part.base)
         groups = scene.prepared(("edge groups", sharp_edges), lambda: merge_edge_groups(
             [(host.groups, part.kind.edges, part.base) for host, part in zip(inputs, parts)], count, FACTOR_SLOTS))
         final, events["crack_free"] = self.stage_crack_free(factors, groups)
@@ -158,7 +158,7 @@ class Tessellator:
         return Plan(scene.name, count, parts, objects, final, vertex_offsets, index_offsets,
                     num_vertices, num_indices, stats, events, started, request)
 
-    def _upload(self, kind: PatchKind, source: np.ndarray) -> dict:
+    def upload(self, kind: PatchKind, source: np.ndarray) -> dict:
         """Device arrays of a kind: "source" (one row per patch) for stage 1, "controls" what
         stage 4 reads (written by stage 1, or the source itself)."""
         data = {"source": cl_array.to_device(self.queue, np.ascontiguousarray(source, np.float32))}
@@ -203,8 +203,8 @@ class Tessellator:
         count = len(patches)
         factors = cl_array.empty(self.queue, (count, FACTOR_SLOTS), np.int32)
         flags = cl_array.empty(self.queue, count, np.int32)
-        events = self._factors(BEZIER, {"source": patches, "controls": patches}, _tolerance(eps, pixels, camera),
-                               max_factor, factors, flags, 0)
+        events = self.stage_factors_of(BEZIER, {"source": patches, "controls": patches},
+                                       _tolerance(eps, pixels, camera), max_factor, factors, flags)
         return factors, flags, events
 
     def stage_pn_factors(self, triangles, eps, pixels, camera, max_factor):
@@ -214,11 +214,13 @@ class Tessellator:
         controls = cl_array.empty(self.queue, (count, 16, 4), np.float32)
         factors = cl_array.empty(self.queue, (count, FACTOR_SLOTS), np.int32)
         flags = cl_array.empty(self.queue, count, np.int32)
-        events = self._factors(PN, {"source": triangles, "controls": controls}, _tolerance(eps, pixels, camera),
-                               max_factor, factors, flags, 0)
+        events = self.stage_factors_of(PN, {"source": triangles, "controls": controls},
+                                       _tolerance(eps, pixels, camera), max_factor, factors, flags)
         return controls, factors, flags, events
 
-    def _factors(self, kind, data, tolerance, max_factor, factors, flags, patch_base):
+    def stage_factors_of(self, kind, data, tolerance, max_factor, factors, flags, patch_base=0):
+        """Stage 1 for a kind: data its device arrays (``upload``), tolerance an ObjectSpace or
+        ScreenSpace; writes factors and flags of its patches at patch_base.., and returns the events."""
         count = len(data["source"])
         event = self.programs.kernel("factors", kind=kind, tolerance=tolerance)(
             self.queue, _global_size(count), None, data["source"].data, data["controls"].data, np.uint32(count),
