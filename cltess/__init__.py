@@ -5,6 +5,7 @@
 >>> export(tess, "teapot.ply")
 """
 from .export import export
+from .request import Request
 from .scene import Camera, Scene, SceneError
 from .tessellation import Tessellation
 
@@ -12,7 +13,7 @@ from .tessellation import Tessellation
 def __getattr__(name):
     # Lazy: importing cltess must not need an OpenCL platform.
     if name == "Tessellator":
-        from .pipeline import Tessellator
+        from .backends.opencl import Tessellator
         return Tessellator
     if name == "load_scene":
         from .formats import load_scene
@@ -20,4 +21,4 @@ def __getattr__(name):
     raise AttributeError(name)
 
 
-__all__ = ["Camera", "Scene", "SceneError", "Tessellation", "Tessellator", "load_scene", "export"]
+__all__ = ["Camera", "Request", "Scene", "SceneError", "Tessellation", "Tessellator", "load_scene", "export"]
