@@ -22,6 +22,7 @@ __kernel void vertices(__global const float4 *controls, __global const int4 *fac
     ulong at = vertex_offsets[p] - vertex_base;
     float3 position, normal;
 
+    __attribute__((opencl_unroll_hint))  /* e constant in each copy: the edge's data in registers */
     for (int e = 0; e < PATTERN_EDGES; ++e)
         for (int k = 0; k < factor_of(f, e); ++k) {
             edge_param t = pattern_ring_param(f, e, k);
