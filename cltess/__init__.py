@@ -10,6 +10,7 @@ from .runtimes import register_pip_runtimes
 register_pip_runtimes()
 
 from .export import export  # noqa: E402
+from .request import Request  # noqa: E402
 from .scene import Camera, Scene, SceneError  # noqa: E402
 from .tessellation import Tessellation  # noqa: E402
 
@@ -17,7 +18,7 @@ from .tessellation import Tessellation  # noqa: E402
 def __getattr__(name):
     # Lazy: importing cltess must not need an OpenCL platform.
     if name == "Tessellator":
-        from .pipeline import Tessellator
+        from .backends.opencl import Tessellator
         return Tessellator
     if name == "load_scene":
         from .formats import load_scene
@@ -25,4 +26,4 @@ def __getattr__(name):
     raise AttributeError(name)
 
 
-__all__ = ["Camera", "Scene", "SceneError", "Tessellation", "Tessellator", "load_scene", "export"]
+__all__ = ["Camera", "Request", "Scene", "SceneError", "Tessellation", "Tessellator", "load_scene", "export"]

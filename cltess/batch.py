@@ -40,7 +40,7 @@ import numpy as np
 
 from .export import SUPPORTED_EXTENSIONS, atomic_write, ply_face_records, ply_header, ply_vertex_records
 from .meshes import MESH_EXTENSIONS
-from .reference import DEFAULT_MAX_FACTOR
+from .criteria.base import DEFAULT_MAX_FACTOR
 
 MANIFEST_NAME = "manifest.json"
 MANIFEST_VERSION = 1
@@ -279,7 +279,7 @@ def worker_device(name: str | None = None, slot: int = 0):
 def _worker_tessellator(device_name: str | None, slots: dict):
     from distributed import get_worker
 
-    from .pipeline import Tessellator
+    from .backends.opencl import Tessellator
 
     key = (device_name, slots.get(get_worker().address, 0))
     if key not in _TESSELLATORS:
@@ -386,7 +386,7 @@ def _describe(error: BaseException) -> str:
 
 def output_sizes(host) -> np.ndarray:
     """(P+1,) bytes of output before each patch of a HostPlan (the last entry: the total)."""
-    from .pipeline import BYTES_PER_INDEX, BYTES_PER_VERTEX
+    from .tessellation import BYTES_PER_INDEX, BYTES_PER_VERTEX
     return (host.vertex_offsets.astype(np.int64) * BYTES_PER_VERTEX
             + host.index_offsets.astype(np.int64) * BYTES_PER_INDEX)
 
@@ -413,7 +413,7 @@ def plan_task(path: str, options: BatchOptions, slots: dict):
     """On a worker: load the scene and run stages 1-3 once; the HostPlan (kept on the
     cluster) and its stage times."""
     from .formats import load_scene
-    from .pipeline import _span_ms
+    from .backends.opencl.tessellator import _span_ms
 
     scene = load_scene(path)
     tessellator = _worker_tessellator(options.device, slots)

@@ -4,14 +4,17 @@ README "The error bound": the factors make the distance from the surface to the 
 same (u, v), at most the patch's tolerance.  This samples every (or every k-th) output triangle
 at barycentric points of order ``order`` (edges included), interpolates the triangle's vertex
 positions and (u, v), and evaluates the surface there in float64 with the NumPy reference
-(``reference.surface_points`` for Bézier patches, ``reference.pn_surface_points`` for PN
-triangles).  A ratio above 1 means the bound is missed (e.g. saturated patches).
+(``surfaces.bezier.surface_points`` for Bézier patches, ``surfaces.pn.pn_surface_points`` for
+PN triangles).  A ratio above 1 means the bound is missed (e.g. saturated patches).
 """
 from __future__ import annotations
 
 import numpy as np
 
-from . import reference
+from .criteria.filip import pn_tolerances
+from .criteria.tolerance import patch_tolerances
+from .surfaces.bezier import surface_points
+from .surfaces.pn import pn_control_points, pn_surface_points
 
 SAMPLES_PER_CHUNK = 100_000  # bounds the memory of one evaluation (a (n, 4, 4, 4) gather)
 
@@ -20,22 +23,22 @@ def worst_bound_ratio(scene, mesh, eps: float | None = None, pixels: float | Non
                       sharp_edges: str = "straight", order: int = 4, max_triangles: int | None = None) -> float:
     """The worst ratio over samples inside the triangles of ``mesh`` (anything with positions,
     uv, patch_ids and triangles, e.g. a Tessellation) made from ``scene`` with the tolerance
-    ``eps`` or ``pixels`` (per patch, ``reference.patch_tolerances``).  ``max_triangles``: sample
+    ``eps`` or ``pixels`` (per patch, ``criteria.tolerance.patch_tolerances``).  ``max_triangles``: sample
     only every k-th triangle so that at most about this many are measured.  0.0 for no triangles.
     """
-    from .pipeline import PN
+    from .kinds import PN
 
     surfaces, tolerances = [], []
     if scene.num_bezier:
         patches = np.asarray(scene.patches, float)
-        surfaces.append((0, lambda ids, u, v: reference.surface_points(patches, ids, u, v)))
-        tolerances.append(reference.patch_tolerances(patches, eps, pixels, scene.camera)[0])
+        surfaces.append((0, lambda ids, u, v: surface_points(patches, ids, u, v)))
+        tolerances.append(patch_tolerances(patches, eps, pixels, scene.camera)[0])
     if scene.num_triangles:
         source = scene.prepared((PN.name, sharp_edges), lambda: PN.prepare(scene, sharp_edges)).source
-        controls = reference.pn_control_points(np.asarray(source, float))
+        controls = pn_control_points(np.asarray(source, float))
         base = scene.num_bezier
-        surfaces.append((base, lambda ids, u, v: reference.pn_surface_points(controls, ids - base, u, v)))
-        tolerances.append(reference.pn_tolerances(controls, eps, pixels, scene.camera)[0])
+        surfaces.append((base, lambda ids, u, v: pn_surface_points(controls, ids - base, u, v)))
+        tolerances.append(pn_tolerances(controls, eps, pixels, scene.camera)[0])
     tolerance = np.concatenate(tolerances)
     triangles = np.asarray(mesh.triangles, np.int64)
     if max_triangles and len(triangles) > max_triangles:

@@ -1,4 +1,4 @@
-"""Scene files -> :class:`~cltess.scene.Scene` (patch layout: DESIGN.md section 2).
+"""Scene files -> :class:`~cltess.scene.Scene` (patch layout: docs/design.md section 2).
 
 Three formats, chosen by extension (``load_scene``):
 
@@ -181,7 +181,7 @@ def _floats(lines: _Lines, ks, rows: list[list[str]]) -> np.ndarray:
 
 
 def _homogeneous(xyzw: np.ndarray) -> np.ndarray:
-    """(..., 4) Cartesian ``(x, y, z, w)`` -> homogeneous ``(w x, w y, w z, w)`` (DESIGN.md 2)."""
+    """(..., 4) Cartesian ``(x, y, z, w)`` -> homogeneous ``(w x, w y, w z, w)`` (docs/design.md section 2)."""
     return np.concatenate([xyzw[..., :3] * xyzw[..., 3:], xyzw[..., 3:]], axis=-1)
 
 

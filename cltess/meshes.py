@@ -1,5 +1,5 @@
 """Triangle-mesh files -> :class:`~cltess.scene.TriangleMesh`, through trimesh (PN triangles,
-DESIGN.md section 3).
+docs/design.md section 3).
 
 Any format trimesh reads, chosen by extension: ``.obj``, ``.ply``, ``.stl``, ``.off``,
 ``.glb``/``.gltf`` (all of a glTF scene's meshes, placed by their node transforms, as one mesh).

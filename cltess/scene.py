@@ -1,7 +1,7 @@
 """The scene data model: what every reader produces and every pipeline stage consumes.
 
 A scene is a batch of rational bicubic Bézier patches in homogeneous form, any number of
-triangle meshes (tessellated as PN triangles, DESIGN.md section 3) and an optional camera.
+triangle meshes (tessellated as PN triangles, docs/design.md section 3) and an optional camera.
 
 Patch numbering (``Tessellation.patch_ids``): the scene's Bézier patches first, in the order of
 ``Scene.patches`` (0..P-1), then the triangles of ``Scene.meshes``, mesh after mesh, each in
@@ -9,7 +9,7 @@ face order: face ``f`` of mesh ``m`` is patch ``Scene.mesh_first_patch(m) + f``.
 one mesh (a mesh file), the patch id is the face index.  Every vertex also carries its object
 id, so (object id, patch id - first patch of that object's mesh) names the face.
 
-Bézier patch layout (DESIGN.md section 2, issue 2): ``patches[p, j, i] = (w*x, w*y, w*z, w)``,
+Bézier patch layout (docs/design.md section 2, issue 2): ``patches[p, j, i] = (w*x, w*y, w*z, w)``,
 ``i`` along u, ``j`` along v, both 0..3; the 16 points of a patch in file order are rows
 ``j = 0..3`` of four points ``i = 0..3``.
 
@@ -95,7 +95,7 @@ def boundary_curves(patches: np.ndarray) -> np.ndarray:
 
 @dataclass
 class Camera:
-    """A pinhole camera for screen-space tolerances (DESIGN.md section 7)."""
+    """A pinhole camera for screen-space tolerances (docs/design.md section 7)."""
 
     eye: np.ndarray
     target: np.ndarray
@@ -159,7 +159,7 @@ def _unit_rows(a: np.ndarray) -> np.ndarray:
 
 @dataclass
 class TriangleMesh:
-    """A triangle mesh with vertex normals, tessellated as PN triangles (DESIGN.md section 3).
+    """A triangle mesh with vertex normals, tessellated as PN triangles (docs/design.md section 3).
 
     Checked and repaired on construction; every problem raises :class:`SceneError` naming the
     mesh and the vertex or face (0-based, as the file's loader numbered them):

@@ -5,6 +5,19 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+#: The vertex record: (field, dtype, per-vertex shape), in the order of the kernels' output
+#: (kernels/common.h vertex_out), the Tessellation fields and the writers' columns.
+VERTEX_RECORD = (
+    ("positions", np.float32, (3,)),
+    ("normals", np.float32, (3,)),
+    ("uv", np.float32, (2,)),
+    ("patch_ids", np.int32, ()),
+    ("object_ids", np.int32, ()),
+)
+#: Bytes of one vertex and of one index in the output.
+BYTES_PER_VERTEX = sum(np.dtype(dtype).itemsize * int(np.prod(shape)) for _, dtype, shape in VERTEX_RECORD)
+BYTES_PER_INDEX = 4
+
 
 @dataclass
 class Tessellation:

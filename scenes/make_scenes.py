@@ -2,7 +2,7 @@
 
     python scenes/make_scenes.py
 
-sphere.bpt      an exact unit sphere: 32 rational bicubic patches (DESIGN.md section 2)
+sphere.bpt      an exact unit sphere: 32 rational bicubic patches (docs/design.md section 2)
 torus.bpt       an exact torus (radii 3 and 1): 16 rational bicubic patches, one per pair of quarter circles
 table.bpt       a flat 8 x 6 grid of bicubic patches, the tea table's top
 teapots.json    16 teapot instances on a 4 x 4 grid, with a camera

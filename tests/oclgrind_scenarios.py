@@ -369,7 +369,8 @@ def main(argv=None) -> int:
 
     pyopencl.characterize.nv_compute_capability = lambda device: None
 
-    from cltess.pipeline import Programs, Tessellator
+    from cltess.backends.opencl.programs import Programs
+    from cltess.pipeline import Tessellator
 
     if args.fill_by_copy:
         _fill_by_copy()

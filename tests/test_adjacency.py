@@ -1,4 +1,4 @@
-"""Patch-edge adjacency (cltess/adjacency.py, DESIGN.md section 4) on the shipped models,
+"""Patch-edge adjacency (cltess/adjacency.py, docs/design.md section 4) on the shipped models,
 the exact sphere, hand-made grids and random re-orderings of grids."""
 from __future__ import annotations
 

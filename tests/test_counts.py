@@ -1,30 +1,15 @@
-"""Stage 3 (kernels/counts.cl + pyopencl.scan, Tessellator.stage_counts) against reference.counts."""
+"""Stage 3 (stages/counts.cl + pyopencl.scan, Tessellator.stage_counts): known counts, a large scan,
+kinds side by side.  Random factors against the mirrors: tests/contracts/test_patterns.py."""
 import numpy as np
 import pyopencl.array as cl_array
 
 from cltess import reference
+from support.factors import random_factors, random_triangle_factors
 
 
 def device_offsets(tessellator, factors):
     vertex_offsets, index_offsets, _ = tessellator.stage_counts(cl_array.to_device(tessellator.queue, factors))
     return vertex_offsets.get(), index_offsets.get()
-
-
-def random_factors(rng, count, high=70):
-    factors = rng.integers(1, high, size=(count, 4)).astype(np.int32)
-    uniform = rng.random(count) < 0.3
-    factors[uniform, 2], factors[uniform, 3] = factors[uniform, 0], factors[uniform, 1]
-    factors[rng.random(count) < 0.1] = 0
-    factors[rng.random(count) < 0.05] = 1
-    return factors
-
-
-def test_counts_and_offsets_match_reference(tessellator, rng):
-    factors = random_factors(rng, 1500)
-    vertex_offsets, index_offsets = device_offsets(tessellator, factors)
-    vertex_counts, index_counts = reference.counts(factors)
-    assert np.array_equal(vertex_offsets, reference.offsets(vertex_counts))
-    assert np.array_equal(index_offsets, reference.offsets(index_counts))
 
 
 def test_uniform_grid_counts(tessellator):
@@ -44,18 +29,6 @@ def test_scan_of_a_large_batch(tessellator, rng):
     assert np.array_equal(np.diff(index_offsets), 6 * m * n)
 
 
-def test_pn_counts_and_offsets_match_reference(tessellator, rng):
-    from cltess.pipeline import PN
-    from test_indices import random_triangle_factors
-
-    factors = random_triangle_factors(rng, 1500, high=70)
-    vertex_offsets, index_offsets, _ = tessellator.stage_counts(cl_array.to_device(tessellator.queue, factors),
-                                                                kind=PN)
-    vertex_counts, index_counts = reference.counts(factors, kind="pn")
-    assert np.array_equal(vertex_offsets.get(), reference.offsets(vertex_counts))
-    assert np.array_equal(index_offsets.get(), reference.offsets(index_counts))
-
-
 def test_uniform_triangle_counts(tessellator):
     from cltess.pipeline import PN
 
@@ -69,7 +42,6 @@ def test_uniform_triangle_counts(tessellator):
 def test_counts_of_kinds_side_by_side(tessellator, rng):
     """A scene's (P, 4) factors hold Bézier patches then PN triangles: one scan over both."""
     from cltess.pipeline import BEZIER, PN
-    from test_indices import random_triangle_factors
 
     quads, triangles = random_factors(rng, 300), random_triangle_factors(rng, 500)
     factors = np.concatenate([quads, triangles])

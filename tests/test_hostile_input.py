@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 import tracemalloc
@@ -341,17 +342,15 @@ def test_no_opencl_platform_end_to_end(tmp_path):
 def test_kernel_build_failure_shows_the_build_log(capsys, tmp_path, monkeypatch):
     """A kernel that does not compile: the CLI exits 1 with the compiler's log (the error's
     line and message), through the real Programs build path."""
-    from cltess import pipeline
+    from cltess.backends.opencl import programs
 
     broken = tmp_path / "kernels"
-    broken.mkdir()
-    for source in pipeline.kernel_dir().iterdir():
-        if source.suffix in (".cl", ".h"):
-            (broken / source.name).write_text(source.read_text())
-    (broken / "crack_free.cl").write_text((broken / "crack_free.cl").read_text().replace(
+    shutil.copytree(programs.kernel_dir(), broken, ignore=shutil.ignore_patterns("__pycache__", "*.py"))
+    stage = broken / "stages" / "crack_free.cl"
+    stage.write_text(stage.read_text().replace(
         "uint edge = get_global_id(0);", "uint edge = get_global_id(0) + undeclared_thing_42;"))
-    monkeypatch.setattr(pipeline, "kernel_dir", lambda: broken)
-    monkeypatch.setattr(pipeline.Programs, "_by_context", {})
+    monkeypatch.setattr(programs, "kernel_dir", lambda: broken)
+    monkeypatch.setattr(programs.Programs, "_by_context", {})
     scene = write_scene(tmp_path, "s.bpt", bpt())
     output = tmp_path / "mesh.ply"
     output.write_bytes(EXISTING)

@@ -1,29 +1,11 @@
-"""Stage 5 (kernels/indices.cl, Tessellator.stage_indices) against reference.quad_pattern and
-reference.tri_pattern, and the patterns' own properties."""
+"""The patterns' own properties (cltess.patterns: valid triangulations, the Filip bound on every
+triangle).  The kernels against these mirrors: tests/contracts/test_patterns.py."""
 import itertools
 
 import numpy as np
-import pyopencl.array as cl_array
 from hypothesis import given, settings, strategies as st
 
 from cltess import reference
-from test_counts import random_factors
-
-
-def device_triangles(tessellator, factors):
-    final = cl_array.to_device(tessellator.queue, factors)
-    vertex_offsets, index_offsets, _ = tessellator.stage_counts(final)
-    total = int(index_offsets[len(factors)].get())
-    triangles, _ = tessellator.stage_indices(final, vertex_offsets, index_offsets, (0, total), (0, len(factors)))
-    return triangles.get(), vertex_offsets.get()
-
-
-def test_indices_match_reference_on_random_factors(tessellator, rng):
-    factors = random_factors(rng, 800)
-    got, vertex_offsets = device_triangles(tessellator, factors)
-    expected = [reference.quad_pattern(f)[1] + vertex_offsets[p] for p, f in enumerate(factors)]
-    assert np.array_equal(got, np.concatenate(expected))
-    assert got.max() < vertex_offsets[-1]  # every index in range
 
 
 def assert_pattern_is_a_valid_triangulation(f):
@@ -54,42 +36,6 @@ def test_random_factor_patterns_are_valid(f):
 
 # --- PN triangles: reference.tri_pattern, kernels pn_indices ---------------------------------
 
-def random_triangle_factors(rng, count, high=40):
-    """(count, 4) PN factors (f0, f1, f2, 0): random (often two transition edges), uniform, one
-    transition edge (the other two at the core factor), all 1, culled (0)."""
-    factors = np.zeros((count, 4), np.int32)
-    factors[:, :3] = rng.integers(1, high, size=(count, 3))
-    top = factors[:, :3].max(axis=1)
-    pattern = rng.integers(0, 3, count)
-    factors[pattern == 1, :3] = top[pattern == 1, None]
-    keep = rng.integers(0, 3, count)  # pattern 2: only this edge may stay below the core factor
-    for e in range(3):
-        raise_it = (pattern == 2) & (keep != e)
-        factors[raise_it, e] = top[raise_it]
-    factors[rng.random(count) < 0.05, :3] = 1
-    factors[rng.random(count) < 0.1] = 0
-    return factors
-
-
-def device_pn_triangles(tessellator, factors):
-    from cltess.pipeline import PN
-
-    final = cl_array.to_device(tessellator.queue, factors)
-    vertex_offsets, index_offsets, _ = tessellator.stage_counts(final, kind=PN)
-    total = int(index_offsets[len(factors)].get())
-    triangles, _ = tessellator.stage_indices(final, vertex_offsets, index_offsets, (0, total),
-                                             (0, len(factors)), kind=PN)
-    return triangles.get(), vertex_offsets.get()
-
-
-def test_pn_indices_match_reference_on_random_factors(tessellator, rng):
-    factors = random_triangle_factors(rng, 800)
-    got, vertex_offsets = device_pn_triangles(tessellator, factors)
-    expected = [reference.tri_pattern(f)[1] + vertex_offsets[p] for p, f in enumerate(factors)]
-    assert np.array_equal(got, np.concatenate(expected))
-    assert got.max() < vertex_offsets[-1]
-
-
 EDGE_DIRECTIONS_UV = np.array([[-1.0, 1.0], [0.0, -1.0], [1.0, 0.0]])  # d_e in (u, v)
 
 
@@ -98,7 +44,7 @@ def filip_radius2(f, uv, tris):
     squared radius of its smallest enclosing circle in coordinates (alpha f_a, beta f_b), where
     x = alpha d_a + beta d_b.  <= 1/2 means the Filip bound holds on it: per direction e the
     factors guarantee (D_ee + D_e*) / f_e^2 <= 4 eps, so |surface - triangle| <= 2 eps r^2
-    (Taylor at each point; DESIGN.md section 3).  The core's grid triangles have exactly 1/2."""
+    (Taylor at each point; docs/design.md section 3).  The core's grid triangles have exactly 1/2."""
     p = uv[tris] - uv[tris][:, :1]  # (T, 3, 2)
     best = np.full(len(tris), np.inf)
     for a, b in ((0, 1), (1, 2), (2, 0)):

@@ -5,7 +5,7 @@ import pytest
 
 from cltess import reference
 from support import as_float32, random_patches
-from test_counts import random_factors
+from support.factors import random_factors, random_triangle_factors
 
 FD_POSITION_TOLERANCE = 2e-5  # relative to the patch size, forward differencing vs direct
 
@@ -56,7 +56,7 @@ def test_forward_differencing_agrees_with_direct_evaluation(tessellator, rng):
 
 def test_boundary_points_are_symmetric_and_corners_exact(tessellator, rng):
     """A patch and its mirror (u -> 1 - u) walk edge 0 in opposite directions: the points on it
-    must come out bitwise equal, corners included (DESIGN.md section 4)."""
+    must come out bitwise equal, corners included (docs/design.md section 4)."""
     patch = random_patches(rng, 1, spread=1.0)[0]
     mirrored = patch[:, ::-1]
     for f in (1, 2, 3, 7, 8, 33, 64):
@@ -90,7 +90,6 @@ def device_pn_vertices(tessellator, triangles, factors, forward_differencing):
 @pytest.mark.parametrize("forward_differencing", [False, True], ids=["direct", "fd"])
 def test_pn_vertices_match_reference_on_random_triangles(tessellator, rng, forward_differencing):
     from support import random_pn_triangles
-    from test_indices import random_triangle_factors
 
     triangles = random_pn_triangles(rng, 300, spread=1.0)
     factors = random_triangle_factors(rng, 300, high=40)
@@ -125,7 +124,7 @@ def test_pn_forward_differencing_agrees_with_direct_evaluation(tessellator, rng)
 
 def test_pn_boundary_points_are_bitwise_shared_and_corners_exact(tessellator, rng):
     """Two triangles sharing the edge P1-P2, the second meeting it from the other end and as its
-    edge 1 (corners rotated): the points on it come out bitwise equal (DESIGN.md section 4)."""
+    edge 1 (corners rotated): the points on it come out bitwise equal (docs/design.md section 4)."""
     from support import random_pn_triangles
 
     a = random_pn_triangles(rng, 1, spread=1.0)[0]

@@ -12,7 +12,7 @@ import trimesh
 from cltess.reference import surface_points
 from cltess.scene import Scene
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SCENES = ROOT / "scenes"
 # The data handed to the project (../shared/data beside the checkout); tests that need it skip
 # when it is absent.  CLTESS_DATA overrides, as for the benchmarks.

@@ -1,0 +1,4 @@
+"""The OpenCL backend."""
+from .tessellator import Plan, Tessellator
+
+__all__ = ["Plan", "Tessellator"]

@@ -1,0 +1,91 @@
+"""The OpenCL programs, composed from shared sources with ``#include`` and ``-D`` when they are
+built (as OpenSubdiv's ``Osd::CLEvaluator::Compile`` does), and cached per context.
+
+Each stage is one short generic kernel in ``kernels/stages/<stage>.cl``.  What it is built
+against depends on the stage (``STAGE_AXES``): stage 1 on the kind (its header includes the
+kind's criterion) and the tolerance (``-D TOLERANCE_SCREEN``), stage 2 on the crack policy,
+stages 3 and 5 on the pattern, stage 4 on the kind and the pattern.  The device contract that the
+headers fulfil is in docs/extending.md.
+"""
+from __future__ import annotations
+
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import pyopencl as cl
+from pyopencl.scan import GenericScanKernel
+
+from ...device import BuildError, first_error_line
+
+STAGES = ("factors", "crack_free", "counts", "vertices", "indices")
+#: What each stage's program is composed of: the headers it includes, in this order.
+STAGE_AXES = {
+    "factors": ("kind",),
+    "crack_free": ("crack",),
+    "counts": ("pattern",),
+    "vertices": ("kind", "pattern"),
+    "indices": ("pattern",),
+}
+
+
+def kernel_dir() -> Path:
+    """Folder of the kernel sources (top-level kernels/, installed as cltess.kernels)."""
+    return Path(str(resources.files("cltess.kernels")))
+
+
+def composition(stage: str, kind=None, pattern=None, tolerance=None, crack: str = "crack/max.h"):
+    """(headers, defines) of a stage's program: the kind's and pattern's headers (objects with a
+    ``header``), the crack policy's header, and the tolerance's ``defines`` (stage 1 only)."""
+    parts = {"kind": kind and kind.header, "pattern": pattern and pattern.header, "crack": crack}
+    headers = tuple(parts[axis] for axis in STAGE_AXES[stage])  # stage 1 also reads the tolerance
+    if None in headers:
+        raise ValueError(f"stage {stage} needs {', '.join(STAGE_AXES[stage])}")
+    defines = dict(tolerance.defines) if stage == "factors" and tolerance is not None else {}
+    return headers, defines
+
+
+class Programs:
+    """The built programs of one context, each built once per composition (pyopencl also
+    caches the binaries on disk)."""
+
+    _by_context: dict = {}
+
+    def __init__(self, context: cl.Context):
+        self.context = context
+        self._kernels: dict = {}
+        self.offsets_scan = GenericScanKernel(
+            context, np.uint64, arguments="__global const ulong *counts, __global ulong *offsets",
+            input_expr="counts[i]", scan_expr="a+b", neutral="0",
+            output_statement="offsets[i + 1] = item;")
+
+    def kernel(self, stage: str, **axes) -> cl.Kernel:
+        """The stage's kernel composed for ``axes`` (kind=, pattern=, tolerance=, crack=)."""
+        headers, defines = composition(stage, **axes)
+        key = (stage, headers, tuple(sorted(defines.items())))
+        if key not in self._kernels:
+            self._kernels[key] = getattr(self.build(stage, headers, defines), stage)
+        return self._kernels[key]
+
+    def compose(self, kind, pattern, tolerance) -> None:
+        """Build (or find) every stage's program for one (kind, pattern, tolerance) now."""
+        for stage in STAGES:
+            self.kernel(stage, kind=kind, pattern=pattern, tolerance=tolerance)
+
+    def build(self, stage: str, headers: tuple, defines: dict) -> cl.Program:
+        folder = kernel_dir()
+        source = "".join(f'#include "{header}"\n' for header in ("common.h", *headers))
+        source += (folder / "stages" / f"{stage}.cl").read_text()
+        options = ["-I", str(folder)] + [f"-D{name}={value}" for name, value in sorted(defines.items())]
+        try:
+            return cl.Program(self.context, source).build(options=options)
+        except cl.RuntimeError as error:  # the build log is in the message
+            raise BuildError(f"kernels/stages/{stage}.cl with {', '.join(headers)} failed to build on "
+                             f"{self.context.devices[0].name.strip()!r}: {first_error_line(error)}. "
+                             "The full log: --verbose", log=str(error)) from error
+
+    @classmethod
+    def of(cls, context: cl.Context) -> "Programs":
+        if context not in cls._by_context:
+            cls._by_context[context] = cls(context)
+        return cls._by_context[context]

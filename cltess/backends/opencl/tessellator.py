@@ -1,0 +1,426 @@
+"""The OpenCL backend: the five stages on one OpenCL device (docs/design.md section 1).
+
+    1. factors     stages/factors.cl     kind_factors of the kind (and its criterion), per tolerance
+    2. crack-free  stages/crack_free.cl  the crack policy (crack/max.h), every kind at once
+    3. counts      stages/counts.cl      the pattern's vertex layout and primitives (count mode),
+                                         then pyopencl.scan into offsets
+    4. vertices    stages/vertices.cl    the kind evaluated at the pattern's points
+    5. indices     stages/indices.cl     the pattern's primitives (emit mode)
+
+Programs are composed per (kind, pattern, tolerance) (programs.py).  The scene's patches are
+numbered kind after kind (``cltess.kinds.KINDS``), and one (P, 4) factor array, one crack-free
+pass, one scan, one Plan and its batches cover them all.  A kind's kernels take
+``patch_base``, the scene number of the kind's first patch; factors, offsets, object ids and
+patch ids are indexed by scene number.
+
+Everything between stage 1 and stage 5 stays on the device; the host reads back the two totals
+to size the output buffers, then the outputs.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import pyopencl as cl
+import pyopencl.array as cl_array
+
+from ...criteria.tolerance import ObjectSpace, ScreenSpace
+from ...crack.adjacency import merge_edge_groups
+from ...device import pick_device
+from ...limits import OutputTooLarge, check_totals
+from ...kinds import BEZIER, FACTOR_SLOTS, FLAG_CULLED, FLAG_SATURATED, KINDS, PN, PatchKind
+from ...kinds import kind as kind_named
+from ...patterns import PATTERNS, Pattern
+from ...request import Request
+from ...scene import Scene
+from ...tessellation import BYTES_PER_INDEX, BYTES_PER_VERTEX, VERTEX_RECORD, Tessellation
+from .programs import Programs
+
+WORK_GROUP = 64  # global sizes are rounded up to this; kernels guard their index
+
+
+@dataclass
+class PlanPart:
+    """One kind's patches in a plan: scene numbers ``base .. base + count - 1``, tessellated
+    with ``pattern``; data: its device arrays ("source", "controls")."""
+
+    kind: PatchKind
+    pattern: Pattern
+    base: int
+    count: int
+    data: dict
+
+
+def _pattern(kind_or_pattern) -> Pattern:
+    return kind_or_pattern if isinstance(kind_or_pattern, Pattern) else kind_named(kind_or_pattern).pattern
+
+
+def _tolerance(eps, pixels, camera):
+    return ObjectSpace(eps) if pixels is None else ScreenSpace(pixels, camera)
+
+
+def _global_size(n: int) -> tuple[int]:
+    return (max(WORK_GROUP, -(-n // WORK_GROUP) * WORK_GROUP),)
+
+
+def _span_ms(events) -> float:
+    """Device milliseconds from the first event's start to the last one's end."""
+    return (events[-1].profile.end - events[0].profile.start) * 1e-6
+
+
+class Tessellator:
+    """Tessellates scenes on one OpenCL device.
+
+    >>> tess = Tessellator().tessellate(load_scene("scenes/teapot.bez"), eps=1e-3)
+    """
+
+    name = "opencl"
+
+    def __init__(self, device: cl.Device | str | None = None):
+        self.device = device if isinstance(device, cl.Device) else pick_device(device)
+        self.context = cl.Context([self.device])
+        self.queue = cl.CommandQueue(self.context, properties=cl.command_queue_properties.PROFILING_ENABLE)
+        self.programs = Programs.of(self.context)
+
+    def tessellate(self, scene: Scene, request: Request | None = None, **options) -> Tessellation:
+        """Run the five stages on a scene; returns the mesh and per-stage device times.
+
+        Give a ``Request``, or its parts as keyword arguments (``Request.of``): exactly one of
+        ``eps`` (object-space tolerance) and ``pixels`` (screen-space, needs ``scene.camera``),
+        ``max_factor``, ``forward_differencing``, ``sharp_edges`` (meshes only: "straight",
+        "average" or "keep", ``cltess.kinds.pn.pn_edge_normals``; only "keep" may leave cracks).
+        """
+        plan = self.plan(scene, request, **options)
+        return self.emit(plan, 0, plan.num_patches)
+
+    def tessellate_in_batches(self, scene: Scene, max_output_bytes: int, request: Request | None = None,
+                              **options):
+        """(plan, iterator of Tessellation batches) whose outputs each fit ``max_output_bytes``.
+
+        Stages 1-3 run once for the whole scene (so factors are crack-free across batches);
+        stages 4-5 run per batch of consecutive patches.  Batch triangles number the vertices
+        globally, so concatenating the batches gives exactly the single-pass result.
+        """
+        plan = self.plan(scene, request, **options)
+        ranges = plan.batch_ranges(max_output_bytes)
+        return plan, (self.emit(plan, first, last) for first, last in ranges)
+
+    def plan(self, scene: Scene, request: Request | None = None, **options) -> "Plan":
+        """Stages 1-3 for the whole scene: final factors and offsets, left on the device."""
+        request = request if request is not None else Request.of(**options)
+        request.check(scene)
+        tolerance = request.tolerance_for(scene)
+        started = time.perf_counter()
+        sharp_edges = request.sharp_edges
+        kinds = [kind for kind in KINDS if kind.count(scene)]
+        # Every program is built before the plan's first buffer exists: builds in between made
+        # Oclgrind's uninitialised-value plugin report the scans' output (tests/test_oclgrind.py).
+        for kind in kinds:
+            self.programs.compose(kind, request.pattern_for(kind), tolerance)
+        parts, inputs, base = [], [], 0
+        for kind in kinds:
+            count = kind.count(scene)
+            host = scene.prepared((kind.name, sharp_edges), lambda: kind.prepare(scene, sharp_edges))
+            parts.append(PlanPart(kind, request.pattern_for(kind), base, count, self.upload(kind, host.source)))
+            inputs.append(host)
+            base += count
+        count = base
+        objects = cl_array.to_device(self.queue, np.concatenate([host.objects for host in inputs]).astype(np.int32))
+        factors = cl_array.empty(self.queue, (count, FACTOR_SLOTS), np.int32)
+        flags = cl_array.empty(self.queue, count, np.int32)
+        events = {"factors": []}
+        for part in parts:
+            events["factors"] += self.stage_factors_of(part.kind, part.data, tolerance, request.max_factor,
+                                                       factors, flags, part.base)
+        groups = scene.prepared(("edge groups", sharp_edges), lambda: merge_edge_groups(
+            [(host.groups, part.kind.edges, part.base) for host, part in zip(inputs, parts)], count, FACTOR_SLOTS))
+        final, events["crack_free"] = self.stage_crack_free(factors, groups)
+        vertex_offsets, index_offsets, events["counts"] = self.stage_counts(
+            final, [(part.pattern, part.base, part.count) for part in parts])
+        num_vertices = int(vertex_offsets[count].get())  # the two read-backs
+        num_indices = int(index_offsets[count].get())
+        check_totals(scene.name, num_vertices)
+        flag_values = flags.get()
+        stats = {
+            "patches": count,
+            "culled": int(np.count_nonzero(flag_values & FLAG_CULLED)),
+            "saturated": int(np.count_nonzero(flag_values & FLAG_SATURATED)),
+            "vertices": num_vertices,
+            "triangles": num_indices // 3,
+            "shared_edges": sum(host.groups.shared for host in inputs),
+            "boundary_edges": sum(host.groups.boundary for host in inputs),
+            "nonmanifold_edges": sum(host.groups.nonmanifold for host in inputs),
+        }
+        for host in inputs:
+            stats.update(host.stats)
+        return Plan(scene.name, count, parts, objects, final, vertex_offsets, index_offsets,
+                    num_vertices, num_indices, stats, events, started, request)
+
+    def upload(self, kind: PatchKind, source: np.ndarray) -> dict:
+        """Device arrays of a kind: "source" (one row per patch) for stage 1, "controls" what
+        stage 4 reads (written by stage 1, or the source itself)."""
+        data = {"source": cl_array.to_device(self.queue, np.ascontiguousarray(source, np.float32))}
+        shape = kind.controls_shape(len(source))
+        data["controls"] = data["source"] if shape is None else cl_array.empty(self.queue, shape, np.float32)
+        return data
+
+    def emit(self, plan: "Plan", first: int, last: int, forward_differencing: bool | None = None) -> Tessellation:
+        """Stages 4-5 for patches ``first .. last-1`` of a plan, read back to the host
+        (forward_differencing: the plan's request's unless given)."""
+        if forward_differencing is None:
+            forward_differencing = plan.request.forward_differencing
+        vertex_range = plan.vertex_range(first, last)
+        index_range = plan.index_range(first, last)
+        events = dict(plan.events) if first == 0 else {}
+        vertices = self._vertex_arrays(vertex_range[1] - vertex_range[0])
+        triangles = cl_array.empty(self.queue, ((index_range[1] - index_range[0]) // 3, 3), np.uint32)
+        events["vertices"], events["indices"] = [], []
+        for part in plan.parts:
+            lo, hi = max(first, part.base), min(last, part.base + part.count)
+            if lo >= hi:
+                continue
+            events["vertices"] += self.stage_vertices(
+                part.data["controls"], plan.factors, plan.vertex_offsets, plan.objects, vertex_range,
+                (lo, hi), forward_differencing, kind=part.kind, patch_base=part.base, out=vertices,
+                pattern=part.pattern)[1]
+            events["indices"] += self.stage_indices(
+                plan.factors, plan.vertex_offsets, plan.index_offsets, index_range, (lo, hi),
+                kind=part.pattern, out=triangles)[1]
+        self.queue.finish()
+        stage_ms = {stage: _span_ms(evs) for stage, evs in events.items() if evs}
+        stage_ms["total_wall"] = (time.perf_counter() - plan.started) * 1e3
+        stats = dict(plan.stats, first_patch=first, last_patch=last)
+        return Tessellation(triangles=triangles.get(), factors=plan.host_factors()[first:last],
+                            stage_ms=stage_ms, stats=stats, **{k: a.get() for k, a in vertices.items()})
+
+    # --- stages 4-5 from a plan made elsewhere (issue 17, cltess/batch.py) -----------------------
+
+    def upload_plan(self, host: "HostPlan", first: int = 0, last: int | None = None) -> "Plan":
+        """A Plan on this device from a plan read back on another (``Plan.to_host``), so that
+        ``emit(plan, a, b)`` runs stages 4-5 for any ``first <= a < b <= last`` without running
+        stages 1-3 again.  Only the controls of patches ``first .. last-1`` are uploaded (the
+        stage-4 kernels read patch p's at ``p - patch_base``, so a part may start mid-kind);
+        factors, offsets and object ids are uploaded whole (36 bytes per patch)."""
+        last = host.num_patches if last is None else last
+        parts = []
+        for (name, pattern, base, count), controls in zip(host.kinds, host.controls):
+            lo, hi = max(first, base), min(last, base + count)
+            if lo < hi:
+                kind = kind_named(name)
+                data = {"controls": cl_array.to_device(self.queue, controls[lo - base:hi - base])}
+                parts.append(PlanPart(kind, PATTERNS[pattern], lo, hi - lo, data))
+        arrays = {name: cl_array.to_device(self.queue, getattr(host, name))
+                  for name in ("objects", "factors", "vertex_offsets", "index_offsets")}
+        return Plan(host.name, host.num_patches, parts, num_vertices=host.num_vertices,
+                    num_indices=host.num_indices, stats=dict(host.stats), events={},
+                    started=time.perf_counter(), request=host.request,
+                    _host={name: getattr(host, name) for name in ("factors", "vertex_offsets", "index_offsets")},
+                    **arrays)
+
+    # --- the stages: device arrays in, device arrays and their events out ----------------------
+
+    def stage_factors(self, patches, eps, pixels, camera, max_factor):
+        """Stage 1 for Bézier patches.  patches: (P, 16, 4) float32 -> factors (P, 4) int32,
+        flags (P,) int32 (bit 0 saturated, bit 1 culled)."""
+        count = len(patches)
+        factors = cl_array.empty(self.queue, (count, FACTOR_SLOTS), np.int32)
+        flags = cl_array.empty(self.queue, count, np.int32)
+        events = self.stage_factors_of(BEZIER, {"source": patches, "controls": patches},
+                                       _tolerance(eps, pixels, camera), max_factor, factors, flags)
+        return factors, flags, events
+
+    def stage_pn_factors(self, triangles, eps, pixels, camera, max_factor):
+        """Stage 1 for PN triangles.  triangles: (T, 12, 4) float32 (PNKind's source) ->
+        controls (T, 16, 4) float32, factors (T, 4) int32 (fourth 0), flags (T,) int32."""
+        count = len(triangles)
+        controls = cl_array.empty(self.queue, (count, 16, 4), np.float32)
+        factors = cl_array.empty(self.queue, (count, FACTOR_SLOTS), np.int32)
+        flags = cl_array.empty(self.queue, count, np.int32)
+        events = self.stage_factors_of(PN, {"source": triangles, "controls": controls},
+                                       _tolerance(eps, pixels, camera), max_factor, factors, flags)
+        return controls, factors, flags, events
+
+    def stage_factors_of(self, kind, data, tolerance, max_factor, factors, flags, patch_base=0):
+        """Stage 1 for a kind: data its device arrays (``upload``), tolerance an ObjectSpace or
+        ScreenSpace; writes factors and flags of its patches at patch_base.., and returns the events."""
+        count = len(data["source"])
+        event = self.programs.kernel("factors", kind=kind, tolerance=tolerance)(
+            self.queue, _global_size(count), None, data["source"].data, data["controls"].data, np.uint32(count),
+            np.uint32(patch_base), *tolerance.kernel_args(), np.int32(max_factor), factors.data, flags.data)
+        return [event]
+
+    def stage_crack_free(self, factors, groups):
+        """Stage 2.  factors (P, 4) int32 and edge groups over its P * 4 entries
+        (cltess.adjacency, or merge_edge_groups for several kinds) -> (P, 4) int32."""
+        edges = factors.size
+        group_of, group_start, members = (cl_array.to_device(self.queue, a.astype(np.int32))
+                                          for a in (groups.group_of, groups.group_start, groups.members))
+        final = cl_array.empty(self.queue, factors.shape, np.int32)
+        event = self.programs.kernel("crack_free")(
+            self.queue, _global_size(edges), None, factors.data, group_of.data, group_start.data,
+            members.data, np.uint32(edges), final.data)
+        return final, [event]
+
+    def stage_counts(self, factors, kind=BEZIER):
+        """Stage 3.  factors (P, 4) -> vertex and index offsets (P+1,) uint64, [P] = total.
+
+        kind: the kind (a PatchKind or its name) or the pattern of every patch, or a list of
+        (kind or pattern, base, count) ranges covering 0..P-1."""
+        count = len(factors)
+        ranges = [(kind, 0, count)] if not isinstance(kind, (list, tuple)) else kind
+        vertex_counts = cl_array.empty(self.queue, count, np.uint64)
+        index_counts = cl_array.empty(self.queue, count, np.uint64)
+        vertex_offsets = cl_array.zeros(self.queue, count + 1, np.uint64)
+        index_offsets = cl_array.zeros(self.queue, count + 1, np.uint64)
+        events = [self.programs.kernel("counts", pattern=_pattern(k))(
+            self.queue, _global_size(n), None, factors.data, np.uint32(n), np.uint32(base),
+            vertex_counts.data, index_counts.data) for k, base, n in ranges if n]
+        events += [self.programs.offsets_scan(vertex_counts, vertex_offsets),
+                   self.programs.offsets_scan(index_counts, index_offsets)]
+        return vertex_offsets, index_offsets, events
+
+    def _vertex_arrays(self, n: int) -> dict:
+        """The vertex record's arrays (VERTEX_RECORD, in the kernel's argument order)."""
+        return {name: cl_array.empty(self.queue, (n, *shape), dtype) for name, dtype, shape in VERTEX_RECORD}
+
+    def stage_vertices(self, controls, factors, vertex_offsets, patch_objects, vertex_range,
+                       patch_range, forward_differencing=True, kind=BEZIER, patch_base=0, out=None,
+                       pattern=None):
+        """Stage 4 for patches patch_range = (first, last) (scene numbers, all of one kind whose
+        first patch is patch_base; controls: that kind's stage-4 input, Bézier patches or PN
+        control points), whose vertices are vertex_range = (start, stop) -> dict of positions
+        (V, 3), normals (V, 3), uv (V, 2), patch_ids (V,), object_ids (V,) device arrays,
+        V = stop - start (written into ``out`` when given), and the events."""
+        out = self._vertex_arrays(vertex_range[1] - vertex_range[0]) if out is None else out
+        first, last = patch_range
+        if vertex_range[1] == vertex_range[0] or last <= first:
+            return out, []
+        kind = kind_named(kind)
+        event = self.programs.kernel("vertices", kind=kind, pattern=pattern or kind.pattern)(
+            self.queue, _global_size(last - first), None, controls.data, factors.data, vertex_offsets.data,
+            patch_objects.data, np.uint32(first), np.uint32(last - first), np.uint32(patch_base),
+            np.uint64(vertex_range[0]), np.int32(forward_differencing), *(a.data for a in out.values()))
+        return out, [event]
+
+    def stage_indices(self, factors, vertex_offsets, index_offsets, index_range, patch_range,
+                      kind=BEZIER, out=None):
+        """Stage 5 for patches patch_range = (first, last) (scene numbers, all of one kind or
+        pattern),
+        whose indices are index_range = (start, stop) -> triangles ((stop - start) / 3, 3) uint32
+        device array (``out`` when given), and the events."""
+        n = index_range[1] - index_range[0]
+        triangles = cl_array.empty(self.queue, (n // 3, 3), np.uint32) if out is None else out
+        first, last = patch_range
+        if not n or last <= first:
+            return triangles, []
+        event = self.programs.kernel("indices", pattern=_pattern(kind))(
+            self.queue, _global_size(last - first), None, factors.data, vertex_offsets.data,
+            index_offsets.data, np.uint32(first), np.uint32(last - first), np.uint64(index_range[0]),
+            triangles.data)
+        return triangles, [event]
+
+
+@dataclass
+class Plan:
+    """Stages 1-3 done for a whole scene: what stages 4-5 need, on the device.
+
+    parts: the kinds' patch ranges and device data (PlanPart); objects: (P,) object ids;
+    factors: (P, 4) final factors; vertex_offsets, index_offsets: (P+1,) exclusive scans with
+    the totals last; stats: the scene's counts (see Tessellation.stats); request: what it was
+    planned for.
+    """
+
+    name: str
+    num_patches: int
+    parts: list
+    objects: cl_array.Array
+    factors: cl_array.Array
+    vertex_offsets: cl_array.Array
+    index_offsets: cl_array.Array
+    num_vertices: int
+    num_indices: int
+    stats: dict
+    events: dict
+    started: float
+    request: Request
+    _host: dict = field(default_factory=dict)
+
+    def host_factors(self) -> np.ndarray:
+        if "factors" not in self._host:
+            self._host["factors"] = self.factors.get()
+        return self._host["factors"]
+
+    def _offsets(self, which: str) -> np.ndarray:
+        if which not in self._host:  # read back only when a range is asked of a partial batch
+            self._host[which] = getattr(self, which).get()
+        return self._host[which]
+
+    def vertex_range(self, first: int, last: int) -> tuple[int, int]:
+        if (first, last) == (0, self.num_patches):
+            return 0, self.num_vertices
+        offsets = self._offsets("vertex_offsets")
+        return int(offsets[first]), int(offsets[last])
+
+    def index_range(self, first: int, last: int) -> tuple[int, int]:
+        if (first, last) == (0, self.num_patches):
+            return 0, self.num_indices
+        offsets = self._offsets("index_offsets")
+        return int(offsets[first]), int(offsets[last])
+
+    @property
+    def output_bytes(self) -> int:
+        return self.num_vertices * BYTES_PER_VERTEX + self.num_indices * BYTES_PER_INDEX
+
+    def batch_ranges(self, max_output_bytes: int) -> list[tuple[int, int]]:
+        """Consecutive patch ranges whose vertex + index output fits max_output_bytes each."""
+        if self.output_bytes <= max_output_bytes:
+            return [(0, self.num_patches)]
+        size = (self._offsets("vertex_offsets").astype(np.int64) * BYTES_PER_VERTEX
+                + self._offsets("index_offsets").astype(np.int64) * BYTES_PER_INDEX)  # < 2**40: check_totals
+        per_patch = np.diff(size)
+        if per_patch.max() > max_output_bytes:
+            worst = int(per_patch.argmax())
+            raise OutputTooLarge(f"{self.name}: patch {worst} alone needs {per_patch[worst]} bytes of output, "
+                                 f"more than the cap of {max_output_bytes}; lower max_factor or raise the cap")
+        ranges, first = [], 0
+        while first < self.num_patches:
+            last = int(np.searchsorted(size, size[first] + max_output_bytes, side="right")) - 1
+            last = max(min(last, self.num_patches), first + 1)
+            ranges.append((first, last))
+            first = last
+        return ranges
+
+    def to_host(self) -> "HostPlan":
+        """Read the plan back to the host (picklable), for ``Tessellator.upload_plan`` on
+        another device or process (issue 17)."""
+        return HostPlan(self.name, self.num_patches,
+                        [(p.kind.name, p.pattern.name, p.base, p.count) for p in self.parts],
+                        [p.data["controls"].get() for p in self.parts], self.objects.get(),
+                        self.host_factors(), self._offsets("vertex_offsets"), self._offsets("index_offsets"),
+                        self.num_vertices, self.num_indices, dict(self.stats), self.request)
+
+
+@dataclass
+class HostPlan:
+    """A Plan on the host: stages 1-3 done, what stages 4-5 need for any patch range.
+
+    kinds: (kind name, pattern name, base, count) per part; controls: each part's stage-4
+    input, (count, 16, 4) float32 (the Bézier patches, or the PN control points stage 1 made);
+    objects (P,) int32; factors (P, 4) int32, final (crack-free); vertex_offsets and
+    index_offsets (P+1,) uint64 with the totals last; stats as Plan.stats; request: what it
+    was planned for.
+    """
+
+    name: str
+    num_patches: int
+    kinds: list
+    controls: list
+    objects: np.ndarray
+    factors: np.ndarray
+    vertex_offsets: np.ndarray
+    index_offsets: np.ndarray
+    num_vertices: int
+    num_indices: int
+    stats: dict
+    request: Request

@@ -1,0 +1,1 @@
+"""Crack policies: which patch edges share a curve, and the factor they agree on."""

@@ -1,0 +1,92 @@
+"""The tolerance field: how much error each patch may have, and which patches are culled
+(docs/design.md section 7).  NumPy mirror of kernels/criteria/tolerance.h, and the host objects
+that choose it: ``ObjectSpace(eps)`` or ``ScreenSpace(pixels, camera)``.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..scene import Camera
+
+
+@dataclass(frozen=True)
+class ObjectSpace:
+    """Every patch gets ``eps`` (object units)."""
+
+    eps: float
+    defines = {}
+
+    def reference(self, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(eps (P,), culled (P,)) for patches in boxes lo, hi (P, 3)."""
+        return box_tolerances(lo, hi, eps=self.eps)
+
+    def kernel_args(self) -> tuple:
+        """eps, view, frustum, pixels, pixel_size: the tolerance arguments of stages/factors.cl."""
+        view, frustum, _ = camera_arguments(None)
+        return np.float32(self.eps), view, frustum, np.float32(0.0), np.float32(0.0)
+
+
+@dataclass(frozen=True)
+class ScreenSpace:
+    """``pixels`` on the screen of ``camera``: eps = pixels * nearest depth * pixel size;
+    patches outside the frustum are culled."""
+
+    pixels: float
+    camera: Camera
+    defines = {"TOLERANCE_SCREEN": "1"}
+
+    def reference(self, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return box_tolerances(lo, hi, pixels=self.pixels, camera=self.camera)
+
+    def kernel_args(self) -> tuple:
+        view, frustum, pixel_size = camera_arguments(self.camera)
+        return np.float32(0.0), view, frustum, np.float32(self.pixels), np.float32(pixel_size)
+
+
+def patch_tolerances(patches: np.ndarray, eps: float | None = None, pixels: float | None = None,
+                     camera: Camera | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Per-patch object-space tolerance and culling.
+
+    patches: (P, 4, 4, 4).  Returns (eps (P,) float64, culled (P,) bool).
+    Object space: every patch gets ``eps``.  Screen space: ``eps = pixels * depth *
+    2 tan(fov_y/2) / height`` with ``depth`` the nearest depth of the patch's bounding box in
+    front of the camera; boxes entirely outside one frustum plane are culled.
+    """
+    points = (patches[..., :3] / patches[..., 3:]).reshape(len(patches), -1, 3)
+    return box_tolerances(points.min(axis=1), points.max(axis=1), eps, pixels, camera)
+
+
+def box_tolerances(lo: np.ndarray, hi: np.ndarray, eps: float | None = None, pixels: float | None = None,
+                   camera: Camera | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """patch_tolerances for patches given by their bounding boxes lo, hi (P, 3)."""
+    count = len(lo)
+    if pixels is None:
+        return np.full(count, float(eps)), np.zeros(count, bool)
+    corners = np.stack([np.where([(c >> a) & 1 for a in range(3)], hi, lo) for c in range(8)], axis=1)
+    view = camera.view_matrix()
+    cam = corners @ view[:3, :3].T + view[:3, 3]  # (P, 8, 3)
+    depth = -cam[..., 2]
+    tan_y = math.tan(math.radians(camera.fov_y_deg) / 2)
+    tan_x = tan_y * camera.width / camera.height
+    outside = [depth < camera.near, depth > camera.far,
+               cam[..., 0] > tan_x * depth, cam[..., 0] < -tan_x * depth,
+               cam[..., 1] > tan_y * depth, cam[..., 1] < -tan_y * depth]
+    culled = np.any([o.all(axis=1) for o in outside], axis=0)
+    nearest = np.maximum(depth.min(axis=1), camera.near)
+    return pixels * nearest * camera.pixel_size_at_unit_depth(), culled
+
+
+def camera_arguments(camera: Camera | None):
+    """(view float16 row-major, frustum (tan_x, tan_y, near, far), pixel size at depth 1)."""
+    import pyopencl as cl  # the cl vector types; imported here so the mirror needs no platform
+
+    if camera is None:
+        return np.zeros(16, np.float32).view(cl.cltypes.float16)[0], \
+            np.zeros(4, np.float32).view(cl.cltypes.float4)[0], 0.0
+    tan_y = math.tan(math.radians(camera.fov_y_deg) / 2)
+    frustum = np.array([tan_y * camera.width / camera.height, tan_y, camera.near, camera.far], np.float32)
+    return (camera.view_matrix().astype(np.float32).reshape(16).view(cl.cltypes.float16)[0],
+            frustum.view(cl.cltypes.float4)[0], camera.pixel_size_at_unit_depth())

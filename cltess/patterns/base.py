@@ -1,0 +1,40 @@
+"""What a tessellation pattern is on the host: its name, domain and device header, and its NumPy
+mirror (docs/extending.md, "A pattern")."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Pattern:
+    """A tessellation pattern: where the points of a patch with edge factors f go, and how they
+    are connected.
+
+    name:      registry name ("quad_transition").
+    domain:    "quad" or "tri": the kinds it serves have this domain.
+    edges:     factors per patch it reads (4 for quads, 3 for triangles).
+    header:    its device header under kernels/ (the contract of docs/extending.md).
+    crack:     the crack policy its boundary needs, a header under kernels/ ("crack/max.h").
+    layout:    the NumPy mirror, f -> (uv (V, 2) float64, triangles (T, 3) int64 local indices):
+               the ring first, then the interior rows, as the device lays the vertices out.
+    """
+
+    name: str
+    domain: str
+    edges: int
+    header: str
+    layout: Callable[[tuple], tuple[np.ndarray, np.ndarray]]
+    crack: str = "crack/max.h"
+    primitive: str = "triangles"
+
+    def counts(self, factors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(vertex counts (P,), index counts (P,)) of each patch's pattern."""
+        layouts = [self.layout(f) for f in factors]
+        return (np.array([len(uv) for uv, _ in layouts], np.int64),
+                np.array([3 * len(t) for _, t in layouts], np.int64))
+
+    def __repr__(self) -> str:
+        return f"<Pattern {self.name}>"

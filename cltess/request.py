@@ -1,0 +1,75 @@
+"""What a tessellation is asked for, as one frozen, validated value (OpenSubdiv's
+``Tessellation::Options`` in spirit): the tolerance, the factor cap, forward differencing, the
+sharp-edge mode and the pattern.  Backends take a ``Request``; ``Tessellator.tessellate(scene,
+eps=..., ...)`` builds one from its keyword arguments (``Request.of``)."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from .criteria.base import DEFAULT_MAX_FACTOR
+from .criteria.tolerance import ObjectSpace, ScreenSpace
+from .kinds import SHARP_EDGE_MODES
+from .limits import check_max_factor, check_patch_count, check_tolerance_value
+from .patterns import PATTERNS
+from .scene import Scene
+
+
+@dataclass(frozen=True)
+class Request:
+    """tolerance:   ObjectSpace(eps), or ScreenSpace(pixels, camera) where camera None means the
+                    scene's camera.
+    max_factor:     the largest edge factor (where the bound needs more, the patch is saturated).
+    forward_differencing: stage 4 walks the interior rows by forward differences (else direct).
+    sharp_edges:    what a mesh edge with different normals on its sides becomes ("straight",
+                    "average" or "keep"; cltess.kinds.pn.pn_edge_normals); other kinds ignore it.
+    pattern:        a registered pattern name for the kinds of its domain (the others keep their
+                    own), or None for each kind's own.
+    """
+
+    tolerance: ObjectSpace | ScreenSpace
+    max_factor: int = DEFAULT_MAX_FACTOR
+    forward_differencing: bool = True
+    sharp_edges: str = "straight"
+    pattern: str | None = None
+
+    def __post_init__(self):
+        value = self.tolerance.eps if isinstance(self.tolerance, ObjectSpace) else self.tolerance.pixels
+        name = "eps" if isinstance(self.tolerance, ObjectSpace) else "pixels"
+        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+        check_tolerance_value(name, value)
+        check_max_factor(self.max_factor)
+        if self.sharp_edges not in SHARP_EDGE_MODES:
+            raise ValueError(f"sharp_edges must be one of {', '.join(SHARP_EDGE_MODES)}, got {self.sharp_edges!r}")
+        if self.pattern is not None and self.pattern not in PATTERNS:
+            raise ValueError(f"unknown pattern {self.pattern!r}; expected one of {', '.join(PATTERNS)}")
+
+    @classmethod
+    def of(cls, eps: float | None = None, pixels: float | None = None, **options) -> "Request":
+        """From the loose keyword arguments of ``Tessellator.tessellate``: exactly one of eps and
+        pixels (the screen-space tolerance uses the scene's camera)."""
+        if (eps is None) == (pixels is None):
+            raise ValueError("give exactly one of eps (object space) and pixels (screen space)")
+        tolerance = ObjectSpace(eps) if eps is not None else ScreenSpace(pixels, None)
+        return cls(tolerance, **options)
+
+    def tolerance_for(self, scene: Scene) -> ObjectSpace | ScreenSpace:
+        """The tolerance with the scene's camera filled in."""
+        if isinstance(self.tolerance, ScreenSpace) and self.tolerance.camera is None:
+            return ScreenSpace(self.tolerance.pixels, scene.camera)
+        return self.tolerance
+
+    def check(self, scene: Scene) -> None:
+        """What the request needs of the scene: patches, and a camera for a pixel tolerance."""
+        if isinstance(self.tolerance, ScreenSpace) and self.tolerance.camera is None and scene.camera is None:
+            raise ValueError(f"{scene.name}: a pixel tolerance needs a camera in the scene")
+        if scene.num_patches == 0:
+            raise ValueError(f"{scene.name}: the scene has no patches")
+        check_patch_count(scene.name, scene.num_patches)
+
+    def pattern_for(self, kind):
+        """The pattern a kind is tessellated with: the requested one where its domain is the
+        kind's, else the kind's own."""
+        chosen = PATTERNS.get(self.pattern) if self.pattern is not None else None
+        return chosen if chosen is not None and chosen.domain == kind.domain else kind.pattern

@@ -1,0 +1,1 @@
+"""NumPy reference evaluation of each patch kind (float64, slow, obviously right)."""

@@ -1,0 +1,218 @@
+/* What every kind, pattern and stage of the cltess pipeline shares: float rules, constants,
+ * Bernstein and forward-difference helpers, the symmetric boundary point, the domains' edge
+ * points, and the writers of vertices and triangles (docs/design.md section 1; the device
+ * contract of kinds, patterns and criteria is in docs/extending.md).
+ *
+ * A program is composed per (kind, pattern, tolerance): cltess/backends/opencl/programs.py
+ * prepends #includes of the kind's and the pattern's headers and -D TOLERANCE_... to one of
+ * the generic stage kernels in stages/. */
+#ifndef CLTESS_COMMON_H
+#define CLTESS_COMMON_H
+
+/* No fused multiply-add: neighbouring patches must evaluate shared boundary points with the
+ * same roundings whatever code path (vector lanes or scalar tail) the compiler gives them. */
+#pragma OPENCL FP_CONTRACT OFF
+
+/* Pinned to the Python constants of the same name by tests/contracts/test_constants.py. */
+#define NORMAL_SHIFT 1.0e-3f      /* cltess.surfaces.bezier.NORMAL_SHIFT */
+#define NORMAL_DEGENERATE 1.0e-3f /* cltess.surfaces.bezier.NORMAL_DEGENERATE */
+#define PN_NORMAL_VANISHES 1.0e-5f /* cltess.surfaces.pn.PN_NORMAL_VANISHES */
+#define FACTOR_SLOTS 4            /* cltess.kinds.base.FACTOR_SLOTS: int4 factors per patch */
+
+/* For the kind functions stage 4 calls per vertex: inlined into the generic stage, as their code
+ * sat inside each kind's own kernel before (PoCL's cost model otherwise keeps kind_eval and
+ * kind_row_begin out of line, and the patch and row state in memory: PN vertices 15-50% slower). */
+#define ALWAYS_INLINE inline __attribute__((always_inline))
+
+/* --- Bernstein bases and power form ---------------------------------------------------------- */
+
+inline void bernstein3(float t, float b[4])
+{
+    float s = 1.0f - t;
+    b[0] = s * s * s;
+    b[1] = 3.0f * t * s * s;
+    b[2] = 3.0f * t * t * s;
+    b[3] = t * t * t;
+}
+
+inline void bernstein2(float t, float b[3])
+{
+    float s = 1.0f - t;
+    b[0] = s * s;
+    b[1] = 2.0f * t * s;
+    b[2] = t * t;
+}
+
+inline float4 lerp4(float4 a, float4 b, float t) { return a + t * (b - a); }
+
+inline float dot3(float3 a, float3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+
+inline float3 unit_or_zero(float3 a)
+{
+    float len = sqrt(dot3(a, a));
+    return len > 0.0f ? a / len : (float3)(0.0f);
+}
+
+/* Power-form coefficients of the cubic Bernstein polynomial with controls c. */
+inline void power_form(const float4 c[4], float4 a[4])
+{
+    a[0] = c[0];
+    a[1] = 3.0f * (c[1] - c[0]);
+    a[2] = 3.0f * (c[2] - 2.0f * c[1] + c[0]);
+    a[3] = c[3] - 3.0f * c[2] + 3.0f * c[1] - c[0];
+}
+
+/* Forward differences of a cubic a0 + a1 u + a2 u^2 + a3 u^3 at u = 0, step h (Wallace 1990):
+ * value, first, second, third difference (docs/design.md section 6). */
+inline void cubic_differences(float4 a0, float4 a1, float4 a2, float4 a3, float h, float4 d[4])
+{
+    float h2 = h * h, h3 = h2 * h;
+    d[0] = a0;
+    d[1] = a1 * h + a2 * h2 + a3 * h3;
+    d[2] = 2.0f * a2 * h2 + 6.0f * a3 * h3;
+    d[3] = 6.0f * a3 * h3;
+}
+
+inline void step_differences(float4 d[4])
+{
+    d[0] += d[1];
+    d[1] += d[2];
+    d[2] += d[3];
+}
+
+/* --- boundary points (docs/design.md section 4) ---------------------------------------------- */
+
+/* Point k of f on an edge: the pattern says which (pattern_ring_param), the kind places it
+ * (kind_boundary_point) and the domain gives its parameters (quad_edge_point, tri_edge_point). */
+typedef struct {
+    int k;
+    int f;
+} edge_param;
+
+/* Point t of a cubic boundary curve with controls c, placed symmetrically about the midpoint:
+ * de Casteljau from the nearer end, and at the midpoint the commutative (a + b) / 2.  A
+ * neighbour walking the shared curve the other way gets bitwise the same point (Mesa's
+ * tessellator does the same for D3D11 patterns).  k = 0 returns the end control point exactly. */
+inline float4 boundary_point(const float4 c[4], edge_param t)
+{
+    int k = t.k, f = t.f;
+    /* The corner itself, bit for bit: c0 + 0 * (c1 - c0) turns a -0.0 of c0 into +0.0 or not
+     * depending on c1, which differs between the patches meeting there. */
+    if (k == 0)
+        return c[0];
+    float4 q[4];
+    int forward = 2 * k < f;
+    for (int i = 0; i < 4; ++i)
+        q[i] = forward ? c[i] : c[3 - i];
+    if (2 * k == f) {
+        for (int level = 3; level > 0; --level)
+            for (int i = 0; i < level; ++i)
+                q[i] = (q[i] + q[i + 1]) * 0.5f;
+    } else {
+        float s = (float)min(k, f - k) / (float)f;
+        for (int level = 3; level > 0; --level)
+            for (int i = 0; i < level; ++i)
+                q[i] = lerp4(q[i], q[i + 1], s);
+    }
+    return q[0];
+}
+
+/* --- domains: the point of an edge parameter, (u, v, w) with uv = .xy ------------------------- */
+
+/* Quad (u, v, 0); edges counter-clockwise 0: v=0, 1: u=1, 2: v=1, 3: u=0. */
+inline float3 quad_edge_point(int e, edge_param p)
+{
+    float t = (float)p.k / (float)p.f;
+    return e == 0 ? (float3)(t, 0.0f, 0.0f) : e == 1 ? (float3)(1.0f, t, 0.0f)
+         : e == 2 ? (float3)(1.0f - t, 1.0f, 0.0f) : (float3)(0.0f, 1.0f - t, 0.0f);
+}
+
+/* Triangle, barycentric (u, v, w) weighting corners P1, P2, P3; edge e runs from corner e to
+ * corner e+1 (0: P1->P2, w=0; 1: P2->P3, u=0; 2: P3->P1, v=0). */
+inline float3 tri_edge_point(int e, edge_param p)
+{
+    float t = (float)p.k / (float)p.f, s = (float)(p.f - p.k) / (float)p.f;
+    return e == 0 ? (float3)(s, t, 0.0f) : e == 1 ? (float3)(0.0f, s, t) : (float3)(t, 0.0f, s);
+}
+
+/* --- factors ------------------------------------------------------------------------------- */
+
+inline int factor_of(int4 f, int e) { return e == 0 ? f.s0 : e == 1 ? f.s1 : e == 2 ? f.s2 : f.s3; }
+
+/* The factor for a step of 1/inverse: ceil, at least 1; above max_factor it is clamped and
+ * *saturated set (the bound is not met there). */
+inline int edge_factor(float inverse, int max_factor, int *saturated)
+{
+    if (inverse <= (float)max_factor)
+        return max((int)ceil(inverse), 1);
+    *saturated = 1;
+    return max_factor;
+}
+
+/* Why a patch has no output, in stage 1's flags (bit 0 is "saturated"). */
+#define FLAG_SATURATED 1
+#define FLAG_CULLED 2
+#define FLAG_FOLDED 4
+
+/* Stages 4 and 5 run on one batch of patches, first_patch .. first_patch + num_patches - 1
+ * (scene numbering).  Sets this work-item's patch p and its factors f; 0 when it has nothing
+ * to emit (past the batch's end, or culled). */
+inline int batch_patch(uint first_patch, uint num_patches, __global const int4 *factors, uint *p, int4 *f)
+{
+    if (get_global_id(0) >= num_patches)
+        return 0;
+    *p = first_patch + (uint)get_global_id(0);
+    *f = factors[*p];
+    return f->s0 > 0;
+}
+
+inline void load_patch(__global const float4 *patches, uint p, float4 b[16])
+{
+    for (int k = 0; k < 16; ++k)
+        b[k] = patches[16 * p + k];
+}
+
+/* --- output records -------------------------------------------------------------------------- */
+
+/* The vertex record, one array per field (cltess.tessellation.VERTEX_RECORD, in this order). */
+typedef struct {
+    __global float *positions;   /* (V, 3) */
+    __global float *normals;     /* (V, 3) */
+    __global float *uv;          /* (V, 2) */
+    __global int *patch_ids;     /* (V,) */
+    __global int *object_ids;    /* (V,) */
+} vertex_out;
+
+inline void put_vertex(vertex_out out, ulong at, float3 position, float3 normal, float2 uv,
+                       int patch, int object)
+{
+    vstore3(position, at, out.positions);
+    vstore3(normal, at, out.normals);
+    vstore2(uv, at, out.uv);
+    out.patch_ids[at] = patch;
+    out.object_ids[at] = object;
+}
+
+/* One triangle: written when out is not null, always counted ("count" and "emit" modes of
+ * pattern_primitives). */
+inline void put_triangle(__global uint *out, uint *count, uint base, uint a, uint b, uint c)
+{
+    if (out) {
+        out[3 * *count + 0] = base + a;
+        out[3 * *count + 1] = base + b;
+        out[3 * *count + 2] = base + c;
+    }
+    ++*count;
+}
+
+/* Local number of ring point k of edge e: the ring (f_0 + ... points, counter-clockwise, edge
+ * e's points at f_0 + ... + f_{e-1}) comes first in every pattern's vertex layout.  Unused
+ * factor slots are 0. */
+inline uint ring_index(int4 f, int e, int k)
+{
+    int ring = f.s0 + f.s1 + f.s2 + f.s3;
+    int base = e == 0 ? 0 : e == 1 ? f.s0 : e == 2 ? f.s0 + f.s1 : f.s0 + f.s1 + f.s2;
+    return (uint)((base + k) % ring);
+}
+
+#endif

@@ -1,0 +1,47 @@
+/* The tolerance field: how much error a patch may have, and whether it is culled
+ * (docs/design.md section 7; host mirror cltess/criteria/tolerance.py).  Built with
+ * -D TOLERANCE_SCREEN for the screen-space tolerance, else object space. */
+#ifndef CLTESS_CRITERIA_TOLERANCE_H
+#define CLTESS_CRITERIA_TOLERANCE_H
+#include "common.h"
+
+/* What stage 1 reads (ObjectSpace / ScreenSpace.kernel_args on the host): eps (object space),
+ * or the camera: view (row-major 4x4), frustum (tan_x, tan_y, near, far), pixels and the pixel
+ * size at depth 1. */
+typedef struct {
+    float eps;
+    float16 view;
+    float4 frustum;
+    float pixels;
+    float pixel_size;
+} tolerance_args;
+
+/* Object-space tolerance of the patch whose control points lie in the box lo..hi, and whether
+ * it is culled.  Object space: every patch gets eps.  Screen space: eps = pixels * nearest
+ * depth * pixel_size, and a box entirely outside one frustum plane is culled. */
+inline float patch_tolerance(float3 lo, float3 hi, tolerance_args tol, int *culled)
+{
+    *culled = 0;
+#ifndef TOLERANCE_SCREEN
+    return tol.eps;
+#else
+    float16 view = tol.view;
+    float tan_x = tol.frustum.s0, tan_y = tol.frustum.s1, near = tol.frustum.s2, far = tol.frustum.s3;
+    int out_mask = 0x3f;  /* bit per plane: set while every corner so far is outside it */
+    float nearest = INFINITY;
+    for (int c = 0; c < 8; ++c) {
+        float3 w = (float3)((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
+        float x = dot(view.s012, w) + view.s3;
+        float y = dot(view.s456, w) + view.s7;
+        float depth = -(dot(view.s89a, w) + view.sb);
+        int outside = (depth < near) | (depth > far) << 1 | (x > tan_x * depth) << 2
+                    | (x < -tan_x * depth) << 3 | (y > tan_y * depth) << 4 | (y < -tan_y * depth) << 5;
+        out_mask &= outside;
+        nearest = min(nearest, depth);
+    }
+    *culled = out_mask != 0;
+    return tol.pixels * max(nearest, near) * tol.pixel_size;
+#endif
+}
+
+#endif

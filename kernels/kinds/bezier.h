@@ -1,0 +1,230 @@
+/* Rational bicubic Bezier patches: the device side of the kind "bezier" (docs/design.md
+ * section 2; host cltess/kinds/bezier.py, NumPy mirror cltess/surfaces/bezier.py).
+ *
+ * Layout: 16 float4 homogeneous control points b[4*j + i] = (w*x, w*y, w*z, w), i along u, j
+ * along v.  Domain: the unit square (u, v); edges counter-clockwise 0: v=0, 1: u=1, 2: v=1,
+ * 3: u=0 (quad_edge_point).  Stage 1 reads the patches as they are (controls = source). */
+#ifndef CLTESS_KINDS_BEZIER_H
+#define CLTESS_KINDS_BEZIER_H
+#include "common.h"
+#include "criteria/tolerance.h"
+#include "criteria/zs.h"
+
+#define KIND_DOMAIN_EDGES 4
+
+/* --- rational patch evaluation ----------------------------------------------------------------- */
+
+/* The patch moved so that its control points' bounding box is centred on the origin:
+ * t[k] = (b.xyz - b.w c, b.w).  Returns c.  Tangents t = B_u.xyz - B_u.w p cancel in float32 when
+ * |p| is large against the patch; about its own centre they do not (a sphere at (20, 20, 20)
+ * had 1% of its normals flipped near the poles before this). */
+inline float3 centred_patch(const float4 b[16], float4 t[16])
+{
+    float3 lo = b[0].xyz / b[0].w, hi = lo;
+    for (int k = 1; k < 16; ++k) {
+        lo = min(lo, b[k].xyz / b[k].w);
+        hi = max(hi, b[k].xyz / b[k].w);
+    }
+    float3 centre = 0.5f * (lo + hi);
+    for (int k = 0; k < 16; ++k)
+        t[k] = (float4)(b[k].xyz - b[k].w * centre, b[k].w);
+    return centre;
+}
+
+/* Collapse the patch to the row v = const: cubic controls c[i] of B(., v) and d[i] of B_v(., v).
+ * Derivatives use differences of control points, so a collapsed edge gives exactly zero. */
+inline void row_controls(const float4 b[16], float v, float4 c[4], float4 d[4])
+{
+    float bv[4], dv[3];
+    bernstein3(v, bv);
+    bernstein2(v, dv);
+    for (int i = 0; i < 4; ++i) {
+        c[i] = bv[0] * b[i] + bv[1] * b[4 + i] + bv[2] * b[8 + i] + bv[3] * b[12 + i];
+        d[i] = 3.0f * (dv[0] * (b[4 + i] - b[i]) + dv[1] * (b[8 + i] - b[4 + i])
+                       + dv[2] * (b[12 + i] - b[8 + i]));
+    }
+}
+
+/* B, B_u, B_v at (u, v) by the tensor-product Bernstein form. */
+inline void surface_eval(const float4 b[16], float u, float v, float4 *s, float4 *s_u, float4 *s_v)
+{
+    float4 c[4], d[4];
+    float bu[4], du[3];
+    row_controls(b, v, c, d);
+    bernstein3(u, bu);
+    bernstein2(u, du);
+    *s = bu[0] * c[0] + bu[1] * c[1] + bu[2] * c[2] + bu[3] * c[3];
+    *s_u = 3.0f * (du[0] * (c[1] - c[0]) + du[1] * (c[2] - c[1]) + du[2] * (c[3] - c[2]));
+    *s_v = bu[0] * d[0] + bu[1] * d[1] + bu[2] * d[2] + bu[3] * d[3];
+}
+
+/* Unnormalised t_u x t_v with t = (B_d.xyz - B_d.w p) / B.w (the 1/B.w is dropped: same
+ * direction).  Sets *ok when it is not (nearly) vanishing. */
+inline float3 tangent_cross(float4 s, float4 s_u, float4 s_v, int *ok)
+{
+    float3 p = s.xyz / s.w;
+    float3 t_u = s_u.xyz - s_u.w * p;
+    float3 t_v = s_v.xyz - s_v.w * p;
+    float3 n = cross(t_u, t_v);
+    float scale = dot(t_u, t_u) + dot(t_v, t_v);
+    *ok = dot(n, n) > NORMAL_DEGENERATE * NORMAL_DEGENERATE * scale * scale;
+    return n;
+}
+
+/* Second derivatives B_uu, B_uv, B_vv at (u, v), from second differences of the controls. */
+inline void surface_second(const float4 b[16], float u, float v, float4 *s_uu, float4 *s_uv, float4 *s_vv)
+{
+    float4 c[4], d[4], e[4];
+    float bu[4], du[3], bv[2];
+    row_controls(b, v, c, d);
+    bernstein3(u, bu);
+    bernstein2(u, du);
+    bv[0] = 1.0f - v;
+    bv[1] = v;
+    for (int i = 0; i < 4; ++i)  /* controls of B_vv along the row */
+        e[i] = 6.0f * (bv[0] * (b[8 + i] - 2.0f * b[4 + i] + b[i])
+                       + bv[1] * (b[12 + i] - 2.0f * b[8 + i] + b[4 + i]));
+    *s_uu = 6.0f * ((1.0f - u) * (c[2] - 2.0f * c[1] + c[0]) + u * (c[3] - 2.0f * c[2] + c[1]));
+    *s_uv = 3.0f * (du[0] * (d[1] - d[0]) + du[1] * (d[2] - d[1]) + du[2] * (d[3] - d[2]));
+    *s_vv = bu[0] * e[0] + bu[1] * e[1] + bu[2] * e[2] + bu[3] * e[3];
+}
+
+/* Where t_u x t_v vanishes (a collapsed edge), the normal is its first-order term towards the
+ * domain centre, d = (1/2 - u, 1/2 - v): D_d(T_u x T_v) = D_d T_u x T_v + T_u x D_d T_v with
+ * T = B_d.xyz - B_d.w p and D_d p = (d_u T_u + d_v T_v) / B.w (docs/design.md section 2: "the
+ * next-order term").  Second derivatives, not a step inwards: the edge's own float32 noise
+ * (its control points are only nearly equal once far from the origin) stays negligible. */
+inline float3 limit_normal(const float4 b[16], float u, float v, float4 s, float4 s_u, float4 s_v)
+{
+    float4 s_uu, s_uv, s_vv;
+    surface_second(b, u, v, &s_uu, &s_uv, &s_vv);
+    float d_u = 0.5f - u, d_v = 0.5f - v;
+    float3 p = s.xyz / s.w;
+    float3 t_u = s_u.xyz - s_u.w * p, t_v = s_v.xyz - s_v.w * p;
+    float3 dp = (d_u * t_u + d_v * t_v) / s.w;
+    float4 ds_u = d_u * s_uu + d_v * s_uv, ds_v = d_u * s_uv + d_v * s_vv;
+    float3 dt_u = ds_u.xyz - ds_u.w * p - s_u.w * dp;
+    float3 dt_v = ds_v.xyz - ds_v.w * p - s_v.w * dp;
+    return cross(dt_u, t_v) + cross(t_u, dt_v);
+}
+
+/* Unit normal at (u, v), given B, B_u, B_v there: t_u x t_v, or at a collapsed edge its limit
+ * (limit_normal); if that vanishes too, a step towards the centre; else +z. */
+inline float3 surface_normal(const float4 b[16], float u, float v, float4 s, float4 s_u, float4 s_v)
+{
+    int ok;
+    float3 n = tangent_cross(s, s_u, s_v, &ok);
+    if (!ok) {
+        float3 limit = limit_normal(b, u, v, s, s_u, s_v);
+        if (dot(limit, limit) > dot(n, n)) {
+            n = limit;
+        } else {
+            surface_eval(b, u + NORMAL_SHIFT * (0.5f - u), v + NORMAL_SHIFT * (0.5f - v), &s, &s_u, &s_v);
+            n = tangent_cross(s, s_u, s_v, &ok);
+        }
+    }
+    float len = length(n);
+    return len > 0.0f ? n / len : (float3)(0.0f, 0.0f, 1.0f);
+}
+
+/* The 4 control points of edge e, counter-clockwise (cltess/scene.py, boundary_curves). */
+inline void edge_controls(const float4 b[16], int e, float4 c[4])
+{
+    for (int k = 0; k < 4; ++k) {
+        int idx = e == 0 ? k : e == 1 ? 4 * k + 3 : e == 2 ? 15 - k : 12 - 4 * k;
+        c[k] = b[idx];
+    }
+}
+
+/* --- the kind contract (docs/extending.md) ----------------------------------------------------- */
+
+/* Stage 1: factors (m, n, m, n) by edge from the Zheng-Sederberg bound; *flags as FLAG_*. */
+inline int4 kind_factors(__global const float4 *source, __global float4 *controls, uint p,
+                         tolerance_args tol, int max_factor, int *flags)
+{
+    float4 b[16];
+    load_patch(source, p, b);
+    float3 lo = b[0].xyz / b[0].w, hi = lo;
+    for (int k = 1; k < 16; ++k) {
+        float3 point = b[k].xyz / b[k].w;
+        lo = min(lo, point);
+        hi = max(hi, point);
+    }
+    int culled;
+    float eps = patch_tolerance(lo, hi, tol, &culled);
+    if (culled) {
+        *flags = FLAG_CULLED;
+        return (int4)(0);
+    }
+    float2 inverse = zs_inverse_steps(b, eps);  /* docs/rational-bound.md */
+    int saturated = 0;
+    int m = edge_factor(inverse.x, max_factor, &saturated);
+    int n = edge_factor(inverse.y, max_factor, &saturated);
+    *flags = saturated;
+    return (int4)(m, n, m, n);
+}
+
+/* Stages 4: the patch as evaluated, about its own centre (centred_patch). */
+typedef struct {
+    float4 edges[4][4];  /* its boundary curves as given: points on them bitwise like the neighbour's */
+    float4 t[16];        /* the patch moved to its centre: normals and interior points */
+    float3 centre;
+} kind_patch;
+
+ALWAYS_INLINE void kind_load(__global const float4 *controls, uint p, kind_patch *patch)
+{
+    float4 b[16];
+    load_patch(controls, p, b);
+    for (int e = 0; e < 4; ++e)
+        edge_controls(b, e, patch->edges[e]);
+    patch->centre = centred_patch(b, patch->t);
+}
+
+/* Position of point t of edge e, canonical from the edge's own control points. */
+ALWAYS_INLINE float3 kind_boundary_point(const kind_patch *patch, int e, edge_param t)
+{
+    float4 h = boundary_point(patch->edges[e], t);
+    return h.xyz / h.w;
+}
+
+/* Direct evaluation at x = (u, v, 0) (position 0: the normal only). */
+ALWAYS_INLINE void kind_eval(const kind_patch *patch, float3 x, float3 *position, float3 *normal)
+{
+    float4 s, s_u, s_v;
+    surface_eval(patch->t, x.x, x.y, &s, &s_u, &s_v);
+    if (position)
+        *position = s.xyz / s.w + patch->centre;
+    *normal = surface_normal(patch->t, x.x, x.y, s, s_u, s_v);
+}
+
+/* Forward differencing along a row v = start.y from u = 0 to 1 in `steps` steps: B is a cubic in
+ * u with controls c, B_v one with controls d, and B_u the derivative of B (docs/design.md
+ * section 6). */
+typedef struct {
+    float4 s[4], s_u[4], s_v[4];
+} kind_row;
+
+ALWAYS_INLINE void kind_row_begin(const kind_patch *patch, float3 start, float3 end, int steps, kind_row *row)
+{
+    float h = 1.0f / (float)steps;
+    float4 c[4], d[4], a[4], av[4];
+    row_controls(patch->t, start.y, c, d);
+    power_form(c, a);
+    power_form(d, av);
+    cubic_differences(a[0], a[1], a[2], a[3], h, row->s);
+    cubic_differences(a[1], 2.0f * a[2], 3.0f * a[3], (float4)(0.0f), h, row->s_u);
+    cubic_differences(av[0], av[1], av[2], av[3], h, row->s_v);
+}
+
+/* The row's next point, x its domain point (for the normal's fall-backs). */
+ALWAYS_INLINE void kind_row_next(const kind_patch *patch, kind_row *row, float3 x, float3 *position, float3 *normal)
+{
+    step_differences(row->s);
+    step_differences(row->s_u);
+    step_differences(row->s_v);
+    float4 value = row->s[0];
+    *position = value.xyz / value.w + patch->centre;
+    *normal = surface_normal(patch->t, x.x, x.y, value, row->s_u[0], row->s_v[0]);
+}
+
+#endif

@@ -1,0 +1,129 @@
+/* The quad transition pattern (CudaTess section 3, Fig. 3; docs/design.md section 5; NumPy
+ * mirror cltess/patterns/quad_transition.py).  Uniform factors (f0 = f2, f1 = f3): the regular
+ * f0 x f1 grid.  Otherwise an inner grid of core factors A = max(min(f0, f2), 2),
+ * B = max(min(f1, f3), 2) and a transition strip along each edge (patterns/stitch.h).
+ * Vertex layout (patterns/layout.h): the ring, then the inner grid (i / A, j / B), rows
+ * j = 1..B-1, i = 1..A-1. */
+#ifndef CLTESS_PATTERNS_QUAD_TRANSITION_H
+#define CLTESS_PATTERNS_QUAD_TRANSITION_H
+#include "common.h"
+
+#define PATTERN_EDGES 4
+
+/* Core grid factors: the regular grid when uniform, else the inner grid of the ring pattern. */
+inline int2 quad_core(int4 f, int *uniform)
+{
+    *uniform = f.s0 == f.s2 && f.s1 == f.s3;
+    if (*uniform)
+        return (int2)(f.s0, f.s1);
+    return (int2)(max(min(f.s0, f.s2), 2), max(min(f.s1, f.s3), 2));
+}
+
+/* --- the vertex layout ------------------------------------------------------------------------ */
+
+/* Ring point k of edge e is point k of f_e: the edge's own factor. */
+inline edge_param pattern_ring_param(int4 f, int e, int k)
+{
+    edge_param t = {k, factor_of(f, e)};
+    return t;
+}
+
+inline float3 pattern_edge_point(int e, edge_param t) { return quad_edge_point(e, t); }
+
+inline int pattern_rows(int4 f)
+{
+    int uniform;
+    return quad_core(f, &uniform).y - 1;
+}
+
+/* Row j runs along v = j / B from u = 0 to 1 in A steps: point i at (i / A, j / B). */
+inline int pattern_row(int4 f, int j)
+{
+    int uniform;
+    return quad_core(f, &uniform).x;
+}
+
+inline float3 pattern_row_point(int4 f, int j, int i)
+{
+    int uniform;
+    int2 core = quad_core(f, &uniform);
+    return (float3)((float)i / (float)core.x, (float)j / (float)core.y, 0.0f);
+}
+
+#include "patterns/layout.h"
+
+/* --- the triangles ---------------------------------------------------------------------------- */
+
+/* The A x B grid of a patch, computed once: its factors and core. */
+typedef struct {
+    int4 f;
+    int2 core;
+    int uniform;
+} pattern_grid;
+
+inline pattern_grid quad_grid(int4 f)
+{
+    pattern_grid g;
+    g.f = f;
+    g.core = quad_core(f, &g.uniform);
+    return g;
+}
+
+/* Local number of grid point (i, j) of the A x B grid: on the boundary a ring point, else an
+ * inner point. */
+inline uint pattern_grid_index(pattern_grid g, int2 point)
+{
+    int4 f = g.f;
+    int i = point.x, j = point.y;
+    if (j == 0) return ring_index(f, 0, i);
+    if (i == g.core.x) return ring_index(f, 1, j);
+    if (j == g.core.y) return ring_index(f, 2, g.core.x - i);
+    if (i == 0) return ring_index(f, 3, g.core.y - j);
+    return (uint)(f.s0 + f.s1 + f.s2 + f.s3 + (j - 1) * (g.core.x - 1) + (i - 1));
+}
+
+#include "patterns/stitch.h"
+
+inline void grid_cells(__global uint *out, uint *count, uint base, pattern_grid g, int i0, int i1, int j0, int j1)
+{
+    for (int j = j0; j < j1; ++j)
+        for (int i = i0; i < i1; ++i) {
+            uint a = pattern_grid_index(g, (int2)(i, j)), b = pattern_grid_index(g, (int2)(i + 1, j));
+            uint c = pattern_grid_index(g, (int2)(i + 1, j + 1)), d = pattern_grid_index(g, (int2)(i, j + 1));
+            put_triangle(out, count, base, a, b, c);
+            put_triangle(out, count, base, a, c, d);
+        }
+}
+
+/* The triangles, in "count" mode (out == 0) or "emit" mode (out != 0): one routine, so the counts
+ * of stage 3 and the indices of stage 5 cannot disagree.  Returns the number of triangles;
+ * vertex numbers are offset by base. */
+inline uint pattern_primitives(int4 f, __global uint *out, uint base)
+{
+    uint count = 0;
+    if (f.s0 <= 0)
+        return 0;
+    pattern_grid g = quad_grid(f);
+    int a = g.core.x, b = g.core.y;
+    if (g.uniform) {
+        grid_cells(out, &count, base, g, 0, a, 0, b);
+        return count;
+    }
+    grid_cells(out, &count, base, g, 1, a - 1, 1, b - 1);
+    /* Edge e's inner polyline runs counter-clockwise along the inner grid's boundary, its point k
+     * at (k + 1) / along of the edge: segment midpoints at (2k + 3) / (2 along). */
+    for (int e = 0; e < 4; ++e) {
+        int along = (e % 2 == 0) ? a : b;
+        stitch_row row;
+        row.start = e == 0 ? (int2)(1, 1) : e == 1 ? (int2)(a - 1, 1) : e == 2 ? (int2)(a - 1, b - 1) : (int2)(1, b - 1);
+        row.step = e == 0 ? (int2)(1, 0) : e == 1 ? (int2)(0, 1) : e == 2 ? (int2)(-1, 0) : (int2)(0, -1);
+        row.first = 0;
+        row.last = along - 2;
+        row.along = along;
+        row.lead = 3;
+        stitch_strip(out, &count, base, g, e, row);
+    }
+    return count;
+}
+
+#endif

@@ -1,0 +1,12 @@
+/* Stage 5: triangle indices, the pattern's primitives in "emit" mode.  One work-item per patch
+ * of one batch (as stage 4); its indices go to index_offsets[p] - index_base and number the
+ * vertices globally (vertex_offsets[p]). */
+__kernel void indices(__global const int4 *factors, __global const ulong *vertex_offsets,
+                      __global const ulong *index_offsets, uint first_patch, uint num_patches,
+                      ulong index_base, __global uint *indices)
+{
+    uint p;
+    int4 f;
+    if (batch_patch(first_patch, num_patches, factors, &p, &f))
+        pattern_primitives(f, indices + (index_offsets[p] - index_base), (uint)vertex_offsets[p]);
+}

@@ -1,0 +1,37 @@
+"""Random final factors for each domain, covering every branch of the patterns (uniform,
+transitions, all 1, culled), and per registered pattern."""
+from __future__ import annotations
+
+import numpy as np
+
+
+def random_factors(rng, count, high=70):
+    """(count, 4) quad factors: random (transitions), uniform, culled (0), all 1."""
+    factors = rng.integers(1, high, size=(count, 4)).astype(np.int32)
+    uniform = rng.random(count) < 0.3
+    factors[uniform, 2], factors[uniform, 3] = factors[uniform, 0], factors[uniform, 1]
+    factors[rng.random(count) < 0.1] = 0
+    factors[rng.random(count) < 0.05] = 1
+    return factors
+
+
+def random_triangle_factors(rng, count, high=40):
+    """(count, 4) PN factors (f0, f1, f2, 0): random (often two transition edges), uniform, one
+    transition edge (the other two at the core factor), all 1, culled (0)."""
+    factors = np.zeros((count, 4), np.int32)
+    factors[:, :3] = rng.integers(1, high, size=(count, 3))
+    top = factors[:, :3].max(axis=1)
+    pattern = rng.integers(0, 3, count)
+    factors[pattern == 1, :3] = top[pattern == 1, None]
+    keep = rng.integers(0, 3, count)  # pattern 2: only this edge may stay below the core factor
+    for e in range(3):
+        raise_it = (pattern == 2) & (keep != e)
+        factors[raise_it, e] = top[raise_it]
+    factors[rng.random(count) < 0.05, :3] = 1
+    factors[rng.random(count) < 0.1] = 0
+    return factors
+
+
+def random_pattern_factors(rng, pattern, count, high=40):
+    """Random final factors for a registered pattern (by its domain)."""
+    return {"quad": random_factors, "tri": random_triangle_factors}[pattern.domain](rng, count, high)
