@@ -171,7 +171,7 @@ typedef struct {
     float3 centre;
 } kind_patch;
 
-ALWAYS_INLINE void kind_load(__global const float4 *controls, uint p, kind_patch *patch)
+ALWAYS_INLINE void kind_load(__global const float4 *controls, uint p, __private kind_patch *patch)
 {
     float4 b[16];
     load_patch(controls, p, b);
@@ -181,14 +181,14 @@ ALWAYS_INLINE void kind_load(__global const float4 *controls, uint p, kind_patch
 }
 
 /* Position of point t of edge e, canonical from the edge's own control points. */
-ALWAYS_INLINE float3 kind_boundary_point(const kind_patch *patch, int e, edge_param t)
+ALWAYS_INLINE float3 kind_boundary_point(__private const kind_patch *patch, int e, edge_param t)
 {
     float4 h = boundary_point(patch->edges[e], t);
     return h.xyz / h.w;
 }
 
 /* Direct evaluation at x = (u, v, 0) (position 0: the normal only). */
-ALWAYS_INLINE void kind_eval(const kind_patch *patch, float3 x, float3 *position, float3 *normal)
+ALWAYS_INLINE void kind_eval(__private const kind_patch *patch, float3 x, __private float3 *position, __private float3 *normal)
 {
     float4 s, s_u, s_v;
     surface_eval(patch->t, x.x, x.y, &s, &s_u, &s_v);
@@ -204,7 +204,7 @@ typedef struct {
     float4 s[4], s_u[4], s_v[4];
 } kind_row;
 
-ALWAYS_INLINE void kind_row_begin(const kind_patch *patch, float3 start, float3 end, int steps, kind_row *row)
+ALWAYS_INLINE void kind_row_begin(__private const kind_patch *patch, float3 start, float3 end, int steps, __private kind_row *row)
 {
     float h = 1.0f / (float)steps;
     float4 c[4], d[4], a[4], av[4];
@@ -217,7 +217,7 @@ ALWAYS_INLINE void kind_row_begin(const kind_patch *patch, float3 start, float3 
 }
 
 /* The row's next point, x its domain point (for the normal's fall-backs). */
-ALWAYS_INLINE void kind_row_next(const kind_patch *patch, kind_row *row, float3 x, float3 *position, float3 *normal)
+ALWAYS_INLINE void kind_row_next(__private const kind_patch *patch, __private kind_row *row, float3 x, __private float3 *position, __private float3 *normal)
 {
     step_differences(row->s);
     step_differences(row->s_u);

@@ -171,7 +171,7 @@ typedef struct {
     float4 edges[3][4];  /* its boundary curves, corner e to corner e+1 */
 } kind_patch;
 
-ALWAYS_INLINE void kind_load(__global const float4 *controls, uint p, kind_patch *patch)
+ALWAYS_INLINE void kind_load(__global const float4 *controls, uint p, __private kind_patch *patch)
 {
     load_patch(controls, p, patch->b);
     for (int e = 0; e < 3; ++e)
@@ -180,13 +180,13 @@ ALWAYS_INLINE void kind_load(__global const float4 *controls, uint p, kind_patch
 
 /* Position of point t of edge e: the edge's own curve, placed symmetrically, so the neighbour's
  * is bitwise the same; corners exact. */
-ALWAYS_INLINE float3 kind_boundary_point(const kind_patch *patch, int e, edge_param t)
+ALWAYS_INLINE float3 kind_boundary_point(__private const kind_patch *patch, int e, edge_param t)
 {
     return boundary_point(patch->edges[e], t).xyz;
 }
 
 /* Direct evaluation at barycentric x (position 0: the normal only). */
-ALWAYS_INLINE void kind_eval(const kind_patch *patch, float3 x, float3 *position, float3 *normal)
+ALWAYS_INLINE void kind_eval(__private const kind_patch *patch, float3 x, __private float3 *position, __private float3 *normal)
 {
     if (position)
         *position = pn_position(patch->b, x);
@@ -200,7 +200,7 @@ typedef struct {
     float4 s[4], nd[4];
 } kind_row;
 
-ALWAYS_INLINE void kind_row_begin(const kind_patch *patch, float3 start, float3 end, int steps, kind_row *row)
+ALWAYS_INLINE void kind_row_begin(__private const kind_patch *patch, float3 start, float3 end, int steps, __private kind_row *row)
 {
     float h = 1.0f / (float)steps;
     float4 c[4], a[4];
@@ -215,7 +215,7 @@ ALWAYS_INLINE void kind_row_begin(const kind_patch *patch, float3 start, float3 
     cubic_differences(q0, 2.0f * (q1 - q0), q0 - 2.0f * q1 + q2, (float4)(0.0f), h, row->nd);
 }
 
-ALWAYS_INLINE void kind_row_next(const kind_patch *patch, kind_row *row, float3 x, float3 *position, float3 *normal)
+ALWAYS_INLINE void kind_row_next(__private const kind_patch *patch, __private kind_row *row, float3 x, __private float3 *position, __private float3 *normal)
 {
     step_differences(row->s);
     step_differences(row->nd);

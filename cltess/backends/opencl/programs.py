@@ -45,6 +45,16 @@ def composition(stage: str, kind=None, pattern=None, tolerance=None, crack: str 
     return headers, defines
 
 
+def program_text(stage: str, headers: tuple, defines: dict) -> tuple[str, list[str]]:
+    """(source, build options) of a composed stage program: ``#include`` lines for common.h and
+    the headers, then the stage's kernel; the kernel folder on the include path, the defines."""
+    folder = kernel_dir()
+    source = "".join(f'#include "{header}"\n' for header in ("common.h", *headers))
+    source += (folder / "stages" / f"{stage}.cl").read_text()
+    options = ["-I", str(folder)] + [f"-D{name}={value}" for name, value in sorted(defines.items())]
+    return source, options
+
+
 class Programs:
     """The built programs of one context, each built once per composition (pyopencl also
     caches the binaries on disk)."""
@@ -73,10 +83,7 @@ class Programs:
             self.kernel(stage, kind=kind, pattern=pattern, tolerance=tolerance)
 
     def build(self, stage: str, headers: tuple, defines: dict) -> cl.Program:
-        folder = kernel_dir()
-        source = "".join(f'#include "{header}"\n' for header in ("common.h", *headers))
-        source += (folder / "stages" / f"{stage}.cl").read_text()
-        options = ["-I", str(folder)] + [f"-D{name}={value}" for name, value in sorted(defines.items())]
+        source, options = program_text(stage, headers, defines)
         try:
             return cl.Program(self.context, source).build(options=options)
         except cl.RuntimeError as error:  # the build log is in the message
