@@ -22,7 +22,7 @@ import threading
 import warnings
 from pathlib import Path
 
-from cltess.export import SUPPORTED_EXTENSIONS, check_extension
+from cltess.export import MESH_FORMATS, SUPPORTED_EXTENSIONS, check_extension
 
 PROG = "cltess"
 DEFAULT_MAX_FACTOR = 64
@@ -141,6 +141,13 @@ def build_parser() -> argparse.ArgumentParser:
                      help="meshes: an edge whose two sides have different vertex normals becomes a "
                           "straight crease (default), a curve from the averaged normals, or keeps "
                           "each side's own PN curve (may crack)")
+    run.add_argument("--weld", action=argparse.BooleanOptionalAction, default=None,
+                     help="write one indexed mesh per object, shared boundary vertices merged exactly "
+                          f"(default for {', '.join(MESH_FORMATS)}; --no-weld: every patch's own vertices, "
+                          "streamed in batches when large; .npz: the Tessellation's arrays unless --weld)")
+    run.add_argument("--uv", choices=("drop", "seam"), default="drop",
+                     help="welded output: drop the per-patch (u, v) (default) or keep them per triangle "
+                          "corner as a seam (.ply face texcoord, .obj vt)")
     run.add_argument("-o", "--output", required=True, metavar="OUT",
                      help=f"output mesh: {', '.join(SUPPORTED_EXTENSIONS)}")
     run.add_argument("-q", "--quiet", action="store_true", help="print nothing on success (warnings still go to stderr)")
@@ -216,6 +223,11 @@ def cmd_tessellate(args) -> int:
 
     output = Path(args.output)
     _check_output_path(output)
+    weld = args.weld if args.weld is not None else output.suffix.lower() in MESH_FORMATS
+    if args.uv == "seam" and not weld:
+        raise UsageError("--uv seam is for welded output (per-patch output keeps every vertex's (u, v))")
+    if args.uv == "seam" and output.suffix.lower() not in (".ply", ".obj", ".npz"):
+        raise UsageError(f"{output}: --uv seam can be written to .ply, .obj or .npz only")
     scene = load_scene(args.scene)
     if args.pixels is not None and scene.camera is None:
         raise UsageError(f"{args.scene}: --pixels needs a camera in the scene (use a .json scene "
@@ -230,7 +242,8 @@ def cmd_tessellate(args) -> int:
 
     tessellator = Tessellator(device=device)
     mesh_options = {"sharp_edges": args.sharp_edges} if scene.meshes else {}
-    result = tessellate_to_file(tessellator, scene, output, max_memory_bytes=args.max_memory, eps=args.eps,
+    result = tessellate_to_file(tessellator, scene, output, max_memory_bytes=args.max_memory, weld=weld,
+                                uv=args.uv, eps=args.eps,
                                 pixels=args.pixels, max_factor=args.max_factor,
                                 forward_differencing=not args.no_fd, **mesh_options)
     if result.batches > 1:
