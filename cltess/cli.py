@@ -145,6 +145,9 @@ def build_parser() -> argparse.ArgumentParser:
                      help="write one indexed mesh per object, shared boundary vertices merged exactly "
                           f"(default for {', '.join(MESH_FORMATS)}; --no-weld: every patch's own vertices, "
                           "streamed in batches when large; .npz: the Tessellation's arrays unless --weld)")
+    run.add_argument("--orient", action=argparse.BooleanOptionalAction, default=True,
+                     help="turn patches to face one way across shared edges and outwards (signed volume); "
+                          "on by default, --no-orient leaves them as the file has them")
     run.add_argument("--uv", choices=("drop", "seam"), default="drop",
                      help="welded output: drop the per-patch (u, v) (default) or keep them per triangle "
                           "corner as a seam (.ply face texcoord, .obj vt)")
@@ -229,6 +232,11 @@ def cmd_tessellate(args) -> int:
     if args.uv == "seam" and output.suffix.lower() not in (".ply", ".obj", ".npz"):
         raise UsageError(f"{output}: --uv seam can be written to .ply, .obj or .npz only")
     scene = load_scene(args.scene)
+    orientation = None
+    if args.orient:
+        from cltess.orient import orient_scene
+
+        scene, orientation = orient_scene(scene)
     if args.pixels is not None and scene.camera is None:
         raise UsageError(f"{args.scene}: --pixels needs a camera in the scene (use a .json scene "
                          "with a \"camera\", or give --eps)")
@@ -248,6 +256,8 @@ def cmd_tessellate(args) -> int:
                                 forward_differencing=not args.no_fd, **mesh_options)
     if result.batches > 1:
         result.stats["batches"] = result.batches
+    if orientation is not None:
+        result.stats.update(orientation.stats())
 
     saturated = int(result.stats.get("saturated", 0))
     if saturated:
