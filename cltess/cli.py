@@ -23,6 +23,7 @@ import warnings
 from pathlib import Path
 
 from cltess.export import MESH_FORMATS, SUPPORTED_EXTENSIONS, check_extension
+from cltess.scene import DEFAULT_CREASE_ANGLE
 
 PROG = "cltess"
 DEFAULT_MAX_FACTOR = 64
@@ -74,6 +75,16 @@ def _max_factor(text: str) -> int:
         return check_max_factor(_factor(text))
     except ValueError as error:
         raise argparse.ArgumentTypeError(str(error).removeprefix("max_factor ")) from None
+
+
+def _crease_angle(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number of degrees: {text!r}") from None
+    if not 0 <= value <= 180:  # NaN fails too
+        raise argparse.ArgumentTypeError(f"must be an angle in 0..180 degrees, got {text!r}")
+    return value
 
 
 def _memory_size(text: str) -> int:
@@ -145,6 +156,9 @@ def build_parser() -> argparse.ArgumentParser:
                      help="write one indexed mesh per object, shared boundary vertices merged exactly "
                           f"(default for {', '.join(MESH_FORMATS)}; --no-weld: every patch's own vertices, "
                           "streamed in batches when large; .npz: the Tessellation's arrays unless --weld)")
+    run.add_argument("--crease-angle", type=_crease_angle, default=DEFAULT_CREASE_ANGLE, metavar="DEG",
+                     help="meshes without normals in the file: edges whose faces meet at more than DEG "
+                          f"degrees stay sharp creases (default {DEFAULT_CREASE_ANGLE:g}; 180: all smooth)")
     run.add_argument("--orient", action=argparse.BooleanOptionalAction, default=True,
                      help="turn patches to face one way across shared edges and outwards (signed volume); "
                           "on by default, --no-orient leaves them as the file has them")
@@ -231,7 +245,7 @@ def cmd_tessellate(args) -> int:
         raise UsageError("--uv seam is for welded output (per-patch output keeps every vertex's (u, v))")
     if args.uv == "seam" and output.suffix.lower() not in (".ply", ".obj", ".npz"):
         raise UsageError(f"{output}: --uv seam can be written to .ply, .obj or .npz only")
-    scene = load_scene(args.scene)
+    scene = load_scene(args.scene, crease_angle=args.crease_angle)
     orientation = None
     if args.orient:
         from cltess.orient import orient_scene
