@@ -27,6 +27,8 @@ from cltess.scene import DEFAULT_CREASE_ANGLE
 
 PROG = "cltess"
 DEFAULT_MAX_FACTOR = 64
+DEFAULT_MAX_OUTPUT = 4 * 2**30  # --max-output: a wrong unit of --eps must not fill a disk
+NOTE_OUTPUT_SIZE = 64 * 2**20  # larger outputs are announced before they are written
 EXIT_OK, EXIT_DEVICE, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
 #: The stats printed on their own summary lines; any other int stat is listed after them.
@@ -56,6 +58,21 @@ def _positive_float(text: str) -> float:
     if not math.isfinite(value) or value <= 0:
         raise argparse.ArgumentTypeError(f"must be a finite number > 0, got {text!r}")
     return value
+
+
+def _tolerance(text: str) -> tuple[float, bool]:
+    """--eps: a distance, or a percentage of the scene's bounding-box diagonal ("0.1%")."""
+    relative = text.strip().endswith("%")
+    value = _positive_float(text.strip()[:-1] if relative else text)
+    if relative and value >= 100:
+        raise argparse.ArgumentTypeError(f"a percentage of the scene's diagonal must be below 100%, got {text!r}")
+    return value, relative
+
+
+def _output_cap(text: str) -> int | None:
+    if text.strip().lower() in ("none", "0"):
+        return None
+    return _memory_size(text)
 
 
 def _factor(text: str) -> int:
@@ -133,8 +150,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     run.add_argument("scene", metavar="SCENE", help="scene file: .bpt, .bez, .json or a triangle mesh")
     tolerance = run.add_mutually_exclusive_group(required=True)
-    tolerance.add_argument("--eps", type=_positive_float, metavar="E",
-                           help="object-space tolerance: max distance from surface to mesh")
+    tolerance.add_argument("--eps", type=_tolerance, metavar="E",
+                           help="object-space tolerance: max distance from surface to mesh, in scene units, "
+                                "or as a percentage of the scene's bounding-box diagonal (0.1%%)")
     tolerance.add_argument("--pixels", type=_positive_float, metavar="PX",
                            help="screen-space tolerance in pixels (needs a camera in the scene)")
     run.add_argument("--no-fd", action="store_true",
@@ -156,6 +174,9 @@ def build_parser() -> argparse.ArgumentParser:
                      help="write one indexed mesh per object, shared boundary vertices merged exactly "
                           f"(default for {', '.join(MESH_FORMATS)}; --no-weld: every patch's own vertices, "
                           "streamed in batches when large; .npz: the Tessellation's arrays unless --weld)")
+    run.add_argument("--max-output", type=_output_cap, default=DEFAULT_MAX_OUTPUT, metavar="SIZE",
+                     help="refuse (before writing) an output file estimated larger than SIZE (e.g. 500M, 20G; "
+                          f"default {DEFAULT_MAX_OUTPUT // 2**30}G; none: no limit)")
     run.add_argument("--crease-angle", type=_crease_angle, default=DEFAULT_CREASE_ANGLE, metavar="DEG",
                      help="meshes without normals in the file: edges whose faces meet at more than DEG "
                           f"degrees stay sharp creases (default {DEFAULT_CREASE_ANGLE:g}; 180: all smooth)")
@@ -231,15 +252,48 @@ def _check_output_path(path: Path) -> None:
         raise UsageError(f"{path}: folder {str(path.parent)!r} does not exist")
 
 
+def _inputs(scene_path: Path) -> list[Path]:
+    """The scene file and, for a JSON scene, the object files it names (as far as it parses)."""
+    import json
+    import stat
+
+    inputs = [scene_path]
+    if scene_path.suffix.lower() == ".json":
+        try:
+            if not stat.S_ISREG(os.stat(scene_path).st_mode):
+                return inputs  # a device or FIFO: never read here; the reader refuses it
+            objects = json.loads(scene_path.read_text()).get("objects", [])
+            inputs += [scene_path.parent / obj["file"] for obj in objects
+                       if isinstance(obj, dict) and isinstance(obj.get("file"), str)]
+        except (OSError, ValueError, AttributeError, TypeError, RecursionError):
+            pass  # the reader reports what is wrong with it
+    return inputs
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        return a.exists() and b.exists() and os.path.samefile(a, b) or a.resolve() == b.resolve()
+    except (OSError, RuntimeError, ValueError):
+        return False
+
+
+def _refuse_overwriting_an_input(output: Path, scene: str) -> None:
+    for source in _inputs(Path(scene)):
+        if _same_file(output, source):
+            raise UsageError(f"{output}: is an input of this run ({source}); choose another -o")
+
+
 def cmd_tessellate(args) -> int:
     """Load, tessellate, export, summarise."""
     from cltess.device import pick_device
     from cltess.formats import load_scene
-    from cltess.limits import eps_below_float32
+    from cltess.export import estimate_output_bytes
+    from cltess.limits import OutputTooLarge, eps_below_float32
     from cltess.stream import tessellate_to_file
 
     output = Path(args.output)
     _check_output_path(output)
+    _refuse_overwriting_an_input(output, args.scene)
     weld = args.weld if args.weld is not None else output.suffix.lower() in MESH_FORMATS
     if args.uv == "seam" and not weld:
         raise UsageError("--uv seam is for welded output (per-patch output keeps every vertex's (u, v))")
@@ -254,7 +308,13 @@ def cmd_tessellate(args) -> int:
     if args.pixels is not None and scene.camera is None:
         raise UsageError(f"{args.scene}: --pixels needs a camera in the scene (use a .json scene "
                          "with a \"camera\", or give --eps)")
+    eps_text = None
     if args.eps is not None:
+        value, relative = args.eps
+        args.eps = value / 100 * scene.diagonal if relative else value
+        eps_text = f"eps {args.eps:.6g}" + (f" = {value:g}% of the diagonal {scene.diagonal:.6g}" if relative else "")
+        if not args.eps > 0:
+            raise UsageError(f"{args.scene}: --eps {value:g}% of the scene's diagonal is 0 (a scene of one point)")
         too_fine = eps_below_float32(scene, args.eps)
         if too_fine:
             print(f"{PROG}: warning: {args.scene}: {too_fine}", file=sys.stderr)
@@ -264,8 +324,22 @@ def cmd_tessellate(args) -> int:
 
     tessellator = Tessellator(device=device)
     mesh_options = {"sharp_edges": args.sharp_edges} if scene.meshes else {}
+    def before_writing(plan):
+        """After stages 1-3, before anything big exists: warn, estimate, refuse."""
+        _warn_saturated(int(plan.stats.get("saturated", 0)), args.max_factor)
+        size = estimate_output_bytes(output.suffix, plan.num_vertices, plan.num_indices // 3, weld,
+                                     args.uv == "seam")
+        what = (f"about {_human(size)} ({plan.num_vertices} vertices{' before welding' if weld else ''}, "
+                f"{plan.num_indices // 3} triangles)")
+        if args.max_output is not None and size > args.max_output:
+            raise OutputTooLarge(f"{output}: the output would be {what}, more than --max-output "
+                                 f"{_human(args.max_output)}; check --eps (its units: the scene's diagonal is "
+                                 f"{scene.diagonal:.6g}), or raise --max-output (or give --max-output none)")
+        if size >= NOTE_OUTPUT_SIZE and not args.quiet:
+            print(f"{PROG}: writing {what} to {output}", file=sys.stderr)
+
     result = tessellate_to_file(tessellator, scene, output, max_memory_bytes=args.max_memory, weld=weld,
-                                uv=args.uv, eps=args.eps,
+                                uv=args.uv, on_plan=before_writing, eps=args.eps,
                                 pixels=args.pixels, max_factor=args.max_factor,
                                 forward_differencing=not args.no_fd, **mesh_options)
     if result.batches > 1:
@@ -273,12 +347,6 @@ def cmd_tessellate(args) -> int:
     if orientation is not None:
         result.stats.update(orientation.stats())
 
-    saturated = int(result.stats.get("saturated", 0))
-    if saturated:
-        patches = "1 patch reaches" if saturated == 1 else f"{saturated} patches reach"
-        verb = "does" if saturated == 1 else "do"
-        print(f"{PROG}: warning: {patches} --max-factor {args.max_factor} and {verb} not meet the error "
-              "bound; raise --max-factor", file=sys.stderr)
     if not int(result.stats.get("triangles", 0)):
         reasons = [f"{result.stats[key]} {label}" for key, label in
                    (("culled", "outside the camera's view"), ("folded_triangles", "folded mesh triangles"))
@@ -291,10 +359,26 @@ def cmd_tessellate(args) -> int:
               "curve, so the mesh may crack there; --sharp-edges straight or average keeps it closed",
               file=sys.stderr)
     if not args.quiet:
-        tolerance = f"eps {args.eps:g}" if args.eps is not None else f"{args.pixels:g} px"
+        tolerance = eps_text if args.eps is not None else f"{args.pixels:g} px"
         print(format_summary(result.stats, result.stage_ms, scene=args.scene, device=device.name.strip(),
                              tolerance=tolerance, output=output))
     return EXIT_OK
+
+
+def _warn_saturated(saturated: int, max_factor: int) -> None:
+    if saturated:
+        patches = "1 patch reaches" if saturated == 1 else f"{saturated} patches reach"
+        verb = "does" if saturated == 1 else "do"
+        print(f"{PROG}: warning: {patches} --max-factor {max_factor} and {verb} not meet the error "
+              "bound; raise --max-factor", file=sys.stderr)
+
+
+def _human(size: int) -> str:
+    """Bytes as 812 B, 3.4 MiB, 1.2 GiB."""
+    for unit, scale in (("GiB", 2**30), ("MiB", 2**20), ("KiB", 2**10)):
+        if size >= scale:
+            return f"{size / scale:.1f} {unit}"
+    return f"{size} B"
 
 
 def format_summary(stats: dict, stage_ms: dict, scene, device: str, tolerance: str, output) -> str:

@@ -489,6 +489,23 @@ SUPPORTED_EXTENSIONS: tuple[str, ...] = tuple(_WRITERS)
 MESH_FORMATS = (".ply", ".obj", ".stl", ".glb")
 
 
+def estimate_output_bytes(extension: str, num_vertices: int, num_triangles: int, weld: bool = False,
+                          seam: bool = False) -> int:
+    """About how many bytes a file of this mesh takes, from the plan's exact totals before
+    anything is made.  Binary formats: exact per-patch, an upper bound welded (welding only
+    merges vertices, its count is known after); OBJ: about 33 bytes per float and 7 per index.
+    Headers are a few hundred bytes."""
+    v, t = int(num_vertices), int(num_triangles)
+    per = {  # (bytes per vertex, bytes per triangle)
+        ".ply": (28, 17 + (25 if seam else 0)) if weld else (PLY_VERTEX_DTYPE.itemsize, PLY_FACE_DTYPE.itemsize),
+        ".obj": (70, 45 + (3 * 25 + 12 if seam else 0)) if weld else (100, 60),
+        ".stl": (0, 50),
+        ".glb": (24, 12),
+        ".npz": (28, 16 + (24 if seam else 0)) if weld else (40, 12),
+    }[extension.lower()]
+    return 512 + v * per[0] + t * per[1]
+
+
 def check_extension(path: str | os.PathLike) -> str:
     """The lower-case extension of ``path`` if it is one :func:`export` writes, else ValueError."""
     extension = Path(path).suffix.lower()

@@ -425,6 +425,21 @@ class Scene:
         """A scene of one ``trimesh.Trimesh`` (see TriangleMesh.from_trimesh for its normals)."""
         return Scene.from_meshes([TriangleMesh.from_trimesh(mesh, object_id, name)], camera, name)
 
+    def bounding_box(self) -> tuple[np.ndarray, np.ndarray]:
+        """(lo (3,), hi (3,)) of every Bézier control point and mesh vertex: it holds the
+        surfaces (convex hull property; PN triangles stay near their vertices)."""
+        points = [self.points.reshape(-1, 3)] + [np.asarray(m.vertices) for m in self.meshes]
+        points = np.concatenate(points) if points else np.zeros((0, 3))
+        if not len(points):
+            return np.zeros(3), np.zeros(3)
+        return points.min(axis=0), points.max(axis=0)
+
+    @property
+    def diagonal(self) -> float:
+        """Length of the bounding box's diagonal (what ``--eps 0.1%`` is a fraction of)."""
+        lo, hi = self.bounding_box()
+        return float(np.linalg.norm(hi - lo))
+
     @property
     def weights(self) -> np.ndarray:
         """(P, 4, 4) weights ``w[p, j, i]``."""
