@@ -29,6 +29,7 @@ PROG = "cltess"
 DEFAULT_MAX_FACTOR = 64
 DEFAULT_MAX_OUTPUT = 4 * 2**30  # --max-output: a wrong unit of --eps must not fill a disk
 NOTE_OUTPUT_SIZE = 64 * 2**20  # larger outputs are announced before they are written
+PROGRESS_DELAY = 1.0  # seconds before a progress bar appears: short runs print none
 EXIT_OK, EXIT_DEVICE, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
 #: The stats printed on their own summary lines; any other int stat is listed after them.
@@ -67,6 +68,20 @@ def _tolerance(text: str) -> tuple[float, bool]:
     if relative and value >= 100:
         raise argparse.ArgumentTypeError(f"a percentage of the scene's diagonal must be below 100%, got {text!r}")
     return value, relative
+
+
+def _image_size(text: str) -> tuple[int, int | None]:
+    """'800' or '800x600': width and optional height, each 16..8192 pixels."""
+    parts = text.lower().split("x")
+    try:
+        if len(parts) > 2:
+            raise ValueError
+        sizes = [int(part) for part in parts]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an image size like 800 or 800x600: {text!r}") from None
+    if not all(16 <= size <= 8192 for size in sizes):
+        raise argparse.ArgumentTypeError(f"sizes must be 16..8192 pixels, got {text!r}")
+    return sizes[0], (sizes[1] if len(sizes) == 2 else None)
 
 
 def _output_cap(text: str) -> int | None:
@@ -142,53 +157,73 @@ def build_parser() -> argparse.ArgumentParser:
                     "($CLTESS_DEVICE, else the first usable CPU device, else the first usable device).",
     )
 
-    run = commands.add_parser(
-        "tessellate", help="tessellate a scene and export the mesh", parents=[verbose],
-        description="Tessellate a scene (.bpt, .bez or .json, or a triangle mesh as PN triangles: "
-                    ".obj, .ply, .stl, .off, .glb, .gltf) and write the mesh "
-                    f"({', '.join(SUPPORTED_EXTENSIONS)}).",
-    )
-    run.add_argument("scene", metavar="SCENE", help="scene file: .bpt, .bez, .json or a triangle mesh")
-    tolerance = run.add_mutually_exclusive_group(required=True)
+    # What tessellate and render share: the scene and how it is tessellated.
+    shared = _Parser(add_help=False)
+    shared.add_argument("scene", metavar="SCENE", help="scene file: .bpt, .bez, .json or a triangle mesh")
+    tolerance = shared.add_mutually_exclusive_group(required=True)
     tolerance.add_argument("--eps", type=_tolerance, metavar="E",
                            help="object-space tolerance: max distance from surface to mesh, in scene units, "
                                 "or as a percentage of the scene's bounding-box diagonal (0.1%%)")
     tolerance.add_argument("--pixels", type=_positive_float, metavar="PX",
                            help="screen-space tolerance in pixels (needs a camera in the scene)")
-    run.add_argument("--no-fd", action="store_true",
-                     help="evaluate every vertex directly instead of by forward differencing")
-    run.add_argument("--max-factor", type=_max_factor, default=DEFAULT_MAX_FACTOR, metavar="N",
-                     help=f"largest edge factor per patch (default {DEFAULT_MAX_FACTOR})")
-    run.add_argument("--device", metavar="NAME",
-                     help="OpenCL device: substring of platform or device name (default $CLTESS_DEVICE, "
-                          "else the first usable CPU device; see 'cltess devices')")
-    run.add_argument("--max-memory", type=_memory_size, metavar="SIZE",
-                     help="cap on the memory the output may take at once (e.g. 512M, 2G); a larger "
-                          "output is tessellated in batches streamed to the file (.ply, .obj). "
-                          "Default: half the device's memory")
-    run.add_argument("--sharp-edges", choices=("straight", "average", "keep"), default="straight",
-                     help="meshes: an edge whose two sides have different vertex normals becomes a "
-                          "straight crease (default), a curve from the averaged normals, or keeps "
-                          "each side's own PN curve (may crack)")
+    shared.add_argument("--no-fd", action="store_true",
+                        help="evaluate every vertex directly instead of by forward differencing")
+    shared.add_argument("--max-factor", type=_max_factor, default=DEFAULT_MAX_FACTOR, metavar="N",
+                        help=f"largest edge factor per patch (default {DEFAULT_MAX_FACTOR})")
+    shared.add_argument("--device", metavar="NAME",
+                        help="OpenCL device: substring of platform or device name (default $CLTESS_DEVICE, "
+                             "else the first usable CPU device; see 'cltess devices')")
+    shared.add_argument("--max-memory", type=_memory_size, metavar="SIZE",
+                        help="cap on the memory the output may take at once (e.g. 512M, 2G); a larger "
+                             "output is tessellated in batches (streamed to a per-patch .ply or .obj). "
+                             "Default: half the device's memory")
+    shared.add_argument("--sharp-edges", choices=("straight", "average", "keep"), default="straight",
+                        help="meshes: an edge whose two sides have different vertex normals becomes a "
+                             "straight crease (default), a curve from the averaged normals, or keeps "
+                             "each side's own PN curve (may crack)")
+    shared.add_argument("--crease-angle", type=_crease_angle, default=DEFAULT_CREASE_ANGLE, metavar="DEG",
+                        help="meshes without normals in the file: edges whose faces meet at more than DEG "
+                             f"degrees stay sharp creases (default {DEFAULT_CREASE_ANGLE:g}; 180: all smooth)")
+    shared.add_argument("--orient", action=argparse.BooleanOptionalAction, default=True,
+                        help="turn patches to face one way across shared edges and outwards (signed volume); "
+                             "on by default, --no-orient leaves them as the file has them")
+    shared.add_argument("-q", "--quiet", action="store_true",
+                        help="print nothing on success, no progress bar (warnings still go to stderr)")
+
+    run = commands.add_parser(
+        "tessellate", help="tessellate a scene and export the mesh", parents=[verbose, shared],
+        description="Tessellate a scene (.bpt, .bez or .json, or a triangle mesh as PN triangles: "
+                    ".obj, .ply, .stl, .off, .glb, .gltf) and write the mesh "
+                    f"({', '.join(SUPPORTED_EXTENSIONS)}).",
+    )
     run.add_argument("--weld", action=argparse.BooleanOptionalAction, default=None,
                      help="write one indexed mesh per object, shared boundary vertices merged exactly "
                           f"(default for {', '.join(MESH_FORMATS)}; --no-weld: every patch's own vertices, "
                           "streamed in batches when large; .npz: the Tessellation's arrays unless --weld)")
-    run.add_argument("--max-output", type=_output_cap, default=DEFAULT_MAX_OUTPUT, metavar="SIZE",
-                     help="refuse (before writing) an output file estimated larger than SIZE (e.g. 500M, 20G; "
-                          f"default {DEFAULT_MAX_OUTPUT // 2**30}G; none: no limit)")
-    run.add_argument("--crease-angle", type=_crease_angle, default=DEFAULT_CREASE_ANGLE, metavar="DEG",
-                     help="meshes without normals in the file: edges whose faces meet at more than DEG "
-                          f"degrees stay sharp creases (default {DEFAULT_CREASE_ANGLE:g}; 180: all smooth)")
-    run.add_argument("--orient", action=argparse.BooleanOptionalAction, default=True,
-                     help="turn patches to face one way across shared edges and outwards (signed volume); "
-                          "on by default, --no-orient leaves them as the file has them")
     run.add_argument("--uv", choices=("drop", "seam"), default="drop",
                      help="welded output: drop the per-patch (u, v) (default) or keep them per triangle "
                           "corner as a seam (.ply face texcoord, .obj vt)")
+    run.add_argument("--max-output", type=_output_cap, default=DEFAULT_MAX_OUTPUT, metavar="SIZE",
+                     help="refuse (before writing) an output file estimated larger than SIZE (e.g. 500M, 20G; "
+                          f"default {DEFAULT_MAX_OUTPUT // 2**30}G; none: no limit)")
+    run.add_argument("--preview", metavar="PNG",
+                     help="also draw the result into this .png (as 'cltess render' does)")
     run.add_argument("-o", "--output", required=True, metavar="OUT",
                      help=f"output mesh: {', '.join(SUPPORTED_EXTENSIONS)}")
-    run.add_argument("-q", "--quiet", action="store_true", help="print nothing on success (warnings still go to stderr)")
+
+    render = commands.add_parser(
+        "render", help="tessellate a scene and draw it into a PNG (no display needed)",
+        parents=[verbose, shared],
+        description="Tessellate a scene and draw it, flat shaded on the CPU, into a .png: front faces "
+                    "grey-blue (or coloured by edge factor), back faces red. The view is the scene's "
+                    "camera if it has one, else one that frames the scene (z up).",
+    )
+    render.add_argument("--size", type=_image_size, default=(800, None), metavar="W[xH]",
+                        help="image size in pixels (default 800 wide, the camera's aspect or 4:3)")
+    render.add_argument("--color", choices=("shade", "factor"), default="shade",
+                        help="front faces in one colour (shade, default) or by their patch's largest edge "
+                             "factor (factor: dark blue 1 to yellow --max-factor, log scale)")
+    render.add_argument("-o", "--output", required=True, metavar="PNG", help="output image (.png)")
 
     bench = commands.add_parser(
         "bench", help="benchmark suite: the CudaTess paper's Tables 1 and 2 on one device",
@@ -283,22 +318,12 @@ def _refuse_overwriting_an_input(output: Path, scene: str) -> None:
             raise UsageError(f"{output}: is an input of this run ({source}); choose another -o")
 
 
-def cmd_tessellate(args) -> int:
-    """Load, tessellate, export, summarise."""
-    from cltess.device import pick_device
+def _prepare_scene(args):
+    """Load, orient and check the scene; turn a relative --eps into a distance.  Returns (scene,
+    orientation report or None, the tolerance as the summary shows it)."""
     from cltess.formats import load_scene
-    from cltess.export import estimate_output_bytes
-    from cltess.limits import OutputTooLarge, eps_below_float32
-    from cltess.stream import tessellate_to_file
+    from cltess.limits import eps_below_float32
 
-    output = Path(args.output)
-    _check_output_path(output)
-    _refuse_overwriting_an_input(output, args.scene)
-    weld = args.weld if args.weld is not None else output.suffix.lower() in MESH_FORMATS
-    if args.uv == "seam" and not weld:
-        raise UsageError("--uv seam is for welded output (per-patch output keeps every vertex's (u, v))")
-    if args.uv == "seam" and output.suffix.lower() not in (".ply", ".obj", ".npz"):
-        raise UsageError(f"{output}: --uv seam can be written to .ply, .obj or .npz only")
     scene = load_scene(args.scene, crease_angle=args.crease_angle)
     orientation = None
     if args.orient:
@@ -318,6 +343,58 @@ def cmd_tessellate(args) -> int:
         too_fine = eps_below_float32(scene, args.eps)
         if too_fine:
             print(f"{PROG}: warning: {args.scene}: {too_fine}", file=sys.stderr)
+    tolerance = eps_text if args.eps is not None else f"{args.pixels:g} px"
+    return scene, orientation, tolerance
+
+
+def _check_preview(name: str, scene: str) -> Path:
+    path = Path(name)
+    if path.suffix.lower() != ".png":
+        raise UsageError(f"{path}: a preview is a .png image")
+    if path.is_dir() or not path.parent.is_dir():
+        raise UsageError(f"{path}: is a directory" if path.is_dir() else
+                         f"{path}: folder {str(path.parent)!r} does not exist")
+    _refuse_overwriting_an_input(path, scene)
+    return path
+
+
+def _progress(args, what: str):
+    """A progress callback (stage, done, total) drawing a tqdm bar on stderr that appears only
+    for runs longer than about a second, or None: with -q, or when stderr is not a terminal."""
+    if args.quiet or not sys.stderr.isatty():
+        return None, contextlib.nullcontext()
+    from tqdm import tqdm
+
+    bar = tqdm(total=1, desc=what, delay=PROGRESS_DELAY, file=sys.stderr, leave=False, unit="patch",
+               bar_format="{desc}: {percentage:3.0f}%|{bar}| {n_fmt}/{total_fmt} [{elapsed}]")
+
+    def update(stage, done, total):
+        if bar.total != total:
+            bar.total = total
+        bar.set_description_str(f"{what}: {stage}", refresh=False)
+        bar.n = done
+        bar.refresh()
+
+    return update, bar
+
+
+def cmd_tessellate(args) -> int:
+    """Load, tessellate, export, summarise."""
+    from cltess.device import pick_device
+    from cltess.export import estimate_output_bytes
+    from cltess.limits import OutputTooLarge
+    from cltess.stream import tessellate_to_file
+
+    output = Path(args.output)
+    _check_output_path(output)
+    _refuse_overwriting_an_input(output, args.scene)
+    weld = args.weld if args.weld is not None else output.suffix.lower() in MESH_FORMATS
+    if args.uv == "seam" and not weld:
+        raise UsageError("--uv seam is for welded output (per-patch output keeps every vertex's (u, v))")
+    if args.uv == "seam" and output.suffix.lower() not in (".ply", ".obj", ".npz"):
+        raise UsageError(f"{output}: --uv seam can be written to .ply, .obj or .npz only")
+    preview = _check_preview(args.preview, args.scene) if args.preview else None
+    scene, orientation, eps_text = _prepare_scene(args)
     device = pick_device(args.device)
 
     from cltess.pipeline import Tessellator  # lazy: builds OpenCL programs
@@ -338,10 +415,26 @@ def cmd_tessellate(args) -> int:
         if size >= NOTE_OUTPUT_SIZE and not args.quiet:
             print(f"{PROG}: writing {what} to {output}", file=sys.stderr)
 
-    result = tessellate_to_file(tessellator, scene, output, max_memory_bytes=args.max_memory, weld=weld,
-                                uv=args.uv, on_plan=before_writing, eps=args.eps,
-                                pixels=args.pixels, max_factor=args.max_factor,
-                                forward_differencing=not args.no_fd, **mesh_options)
+        if progress is not None:
+            progress(f"writing {_human(size)}", 0, plan.num_patches)
+
+    drawing = None
+    if preview is not None:
+        from cltess.render import Rasteriser, view_for
+
+        drawing = Rasteriser(view_for(scene))
+    progress, bar = _progress(args, str(output))
+    with bar:
+        result = tessellate_to_file(
+            tessellator, scene, output, max_memory_bytes=args.max_memory, weld=weld, uv=args.uv,
+            on_plan=before_writing, progress=progress,
+            on_batch=(lambda batch: drawing.add(batch.positions, batch.triangles)) if drawing else None,
+            eps=args.eps, pixels=args.pixels, max_factor=args.max_factor, forward_differencing=not args.no_fd,
+            **mesh_options)
+    if drawing is not None:
+        from cltess.render import write_png
+
+        write_png(preview, drawing.image())
     if result.batches > 1:
         result.stats["batches"] = result.batches
     if orientation is not None:
@@ -359,9 +452,46 @@ def cmd_tessellate(args) -> int:
               "curve, so the mesh may crack there; --sharp-edges straight or average keeps it closed",
               file=sys.stderr)
     if not args.quiet:
-        tolerance = eps_text if args.eps is not None else f"{args.pixels:g} px"
         print(format_summary(result.stats, result.stage_ms, scene=args.scene, device=device.name.strip(),
-                             tolerance=tolerance, output=output))
+                             tolerance=eps_text, output=output if preview is None else f"{output}, {preview}"))
+    return EXIT_OK
+
+
+def cmd_render(args) -> int:
+    """Tessellate in memory-bounded batches, draw each into one z-buffer, write the PNG."""
+    from cltess.device import pick_device
+    from cltess.render import Rasteriser, factor_colours, view_for, write_png
+    from cltess.stream import COPIES_IN_FLIGHT, default_budget
+
+    output = _check_preview(args.output, args.scene)
+    scene, orientation, tolerance = _prepare_scene(args)
+    device = pick_device(args.device)
+
+    from cltess.pipeline import Tessellator  # lazy: builds OpenCL programs
+
+    tessellator = Tessellator(device=device)
+    mesh_options = {"sharp_edges": args.sharp_edges} if scene.meshes else {}
+    plan = tessellator.plan(scene, eps=args.eps, pixels=args.pixels, max_factor=args.max_factor, **mesh_options)
+    _warn_saturated(int(plan.stats.get("saturated", 0)), args.max_factor)
+    budget = args.max_memory or default_budget(tessellator.device)
+    drawing = Rasteriser(view_for(scene, *args.size))
+    progress, bar = _progress(args, str(output))
+    with bar:
+        for first, last in plan.batch_ranges(max(budget // COPIES_IN_FLIGHT, 1)):
+            batch = tessellator.emit(plan, first, last, not args.no_fd)
+            colours = None
+            if args.color == "factor" and batch.num_triangles:
+                patch = batch.patch_ids[batch.triangles[:, 0]] - first
+                colours = factor_colours(batch.factors, patch, args.max_factor)
+            drawing.add(batch.positions, batch.triangles, colours)
+            if progress is not None:
+                progress("drawing", last, plan.num_patches)
+    image = drawing.image()
+    write_png(output, image)
+    if not args.quiet:
+        stats = dict(plan.stats, **(orientation.stats() if orientation else {}))
+        print(format_summary(stats, {}, scene=args.scene, device=device.name.strip(), tolerance=tolerance,
+                             output=f"{output} ({image.shape[1]}x{image.shape[0]})"))
     return EXIT_OK
 
 
@@ -424,7 +554,7 @@ def cmd_bench(args) -> int:
     return EXIT_OK
 
 
-_COMMANDS = {"devices": cmd_devices, "tessellate": cmd_tessellate, "bench": cmd_bench}
+_COMMANDS = {"devices": cmd_devices, "tessellate": cmd_tessellate, "render": cmd_render, "bench": cmd_bench}
 
 
 # --------------------------------------------------------------------------- entry point

@@ -43,7 +43,7 @@ def default_budget(device: cl.Device) -> int:
 
 
 def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = None,
-                       weld: bool = False, uv: str = "drop", on_plan=None, progress=None,
+                       weld: bool = False, uv: str = "drop", on_plan=None, on_batch=None, progress=None,
                        **options) -> StreamResult:
     """Tessellate ``scene`` into ``path`` (.ply, .obj, .stl, .glb or .npz) within ``max_memory_bytes``.
 
@@ -52,6 +52,8 @@ def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = 
     memory, so it must fit the budget in one batch, as must .stl, .glb and .npz output; .ply
     and .obj without weld are streamed batch by batch.  on_plan(plan): called after stages 1-3,
     before anything big is allocated or written (to check or refuse the output size).
+    on_batch(tess): called with each batch's Tessellation (per-patch vertices, before welding),
+    e.g. to draw a preview.
     progress(stage, done, total): called as batches are written.
     """
     path = Path(path)
@@ -74,6 +76,8 @@ def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = 
         tess = tessellator.emit(plan, 0, plan.num_patches, forward_differencing)
         if progress is not None:
             progress("tessellated", 1, 1)
+        if on_batch is not None:
+            on_batch(tess)
         result = tess.welded(uv=uv) if weld else tess
         if progress is not None and weld:
             progress("welded", 1, 1)
@@ -87,6 +91,8 @@ def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = 
             for batch in _emit_fitting(tessellator, plan, first, last, forward_differencing):
                 writer.write_vertices(batch)
                 writer.write_faces(batch.triangles)
+                if on_batch is not None:
+                    on_batch(batch)
                 done.append((batch.stats["first_patch"], batch.stats["last_patch"]))
                 if progress is not None:
                     progress("batches", batch.stats["last_patch"], plan.num_patches)

@@ -121,7 +121,7 @@ def weld(tess, uv: str = "drop", check_t_junctions: bool = True) -> WeldedMesh:
         triangles=faces[keep].astype(np.uint32),
         patch_ids=np.asarray(tess.patch_ids, np.int32)[corners[keep, 0]],
         corner_uv=np.asarray(tess.uv, np.float32)[corners[keep]] if uv == "seam" else None,
-        stats=dict(tess.stats),
+        stats={k: v for k, v in tess.stats.items() if k not in ("first_patch", "last_patch")},
         stage_ms=dict(tess.stage_ms),
     )
     mesh.stats.update(patch_vertices=len(positions), vertices=mesh.num_vertices, triangles=mesh.num_triangles,

@@ -136,3 +136,41 @@ def test_large_outputs_are_announced_before_writing(capsys, tmp_path, monkeypatc
     assert code == 0 and "writing about" in err and "before welding" in err
     code, out, err = run(capsys, "tessellate", SCENES / "teapot.bez", "--eps", "0.01", "-q", "-o", tmp_path / "u.ply")
     assert code == 0 and err == "" and out == ""
+
+
+# --------------------------------------------------------------------------- progress bar
+
+
+class Terminal:
+    """A stderr that says it is a terminal and keeps what is written."""
+
+    def __init__(self):
+        self.text = ""
+
+    def write(self, text):
+        self.text += text
+
+    def flush(self):
+        pass
+
+    def isatty(self):
+        return True
+
+
+def test_progress_bar_on_a_terminal_only_and_not_when_quiet(capsys, tmp_path, monkeypatch):
+    import sys
+
+    monkeypatch.setattr("cltess.cli.PROGRESS_DELAY", 0.0)  # show it even for a short run
+    terminal = Terminal()
+    monkeypatch.setattr(sys, "stderr", terminal)
+    code = main(["tessellate", str(SCENES / "teapot.bez"), "--eps", "0.005", "--no-weld", "--max-memory", "256K",
+                 "-o", str(tmp_path / "t.ply")])
+    assert code == 0
+    assert "batches" in terminal.text and "%|" in terminal.text and "/32" in terminal.text
+    terminal.text = ""
+    code = main(["tessellate", str(SCENES / "teapot.bez"), "--eps", "0.005", "-q", "-o", str(tmp_path / "u.ply")])
+    assert code == 0 and terminal.text == ""
+    monkeypatch.undo()
+    monkeypatch.setattr("cltess.cli.PROGRESS_DELAY", 0.0)
+    code, _, err = run(capsys, "tessellate", SCENES / "teapot.bez", "--eps", "0.005", "-o", tmp_path / "v.ply")
+    assert code == 0 and "%|" not in err  # pytest's captured stderr is not a terminal
