@@ -59,7 +59,16 @@ def view_for(scene, width: int = 800, height: int | None = None, use_camera: boo
     fov = 30.0
     fit = min(np.tan(np.radians(fov) / 2), np.tan(np.radians(fov) / 2) * width / height)
     direction = np.array([0.55, -1.0, 0.6]) / np.linalg.norm([0.55, -1.0, 0.6])
-    eye = centre + direction * radius / fit * 1.05
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    distance = radius / fit  # the bounding sphere fits; then move in until the box's corners do
+    for _ in range(4):
+        matrix = Camera(eye=centre + direction * distance, target=centre).view_matrix()
+        camera = corners @ matrix[:3, :3].T + matrix[:3, 3]
+        depth = np.maximum(-camera[:, 2], 1e-9 * radius)
+        spread = max(np.abs(camera[:, 0] / depth).max() / (np.tan(np.radians(fov) / 2) * width / height),
+                     np.abs(camera[:, 1] / depth).max() / np.tan(np.radians(fov) / 2))
+        distance = max(distance * spread * 1.1, radius * 1.2)
+    eye = centre + direction * distance
     return View(Camera(eye=eye, target=centre).view_matrix(), fov, width, height)
 
 
