@@ -158,3 +158,14 @@ def test_bad_preview_exits_2(capsys, tmp_path):
                        "--preview", tmp_path / "missing" / "s.png")
     assert code == 2 and "does not exist" in err
     assert not any(tmp_path.iterdir())
+
+
+def test_big_guy_stored_inside_out_renders_right_side_out(capsys, tmp_path):
+    """bigguy.bez faces inwards as stored, in 1541 pieces that share no exact edge: each piece
+    is turned by its own signed volume."""
+    for option, name in (("--orient", "good"), ("--no-orient", "raw")):
+        code, _, err = run(capsys, "render", SCENES / "bigguy.bez", "--eps", "0.5%", "--size", "160", option,
+                           "-q", "-o", tmp_path / f"{name}.png")
+        assert code == 0, err
+    assert red_fraction(read_png(tmp_path / "raw.png")) > 0.9
+    assert red_fraction(read_png(tmp_path / "good.png")) < 0.1
