@@ -61,13 +61,18 @@ def _positive_float(text: str) -> float:
     return value
 
 
-def _tolerance(text: str) -> tuple[float, bool]:
+class Percent(float):
+    """An --eps given as a percentage of the scene's bounding-box diagonal (its value: the
+    percentage); it becomes a distance once the scene is loaded."""
+
+
+def _tolerance(text: str) -> float:
     """--eps: a distance, or a percentage of the scene's bounding-box diagonal ("0.1%")."""
     relative = text.strip().endswith("%")
     value = _positive_float(text.strip()[:-1] if relative else text)
     if relative and value >= 100:
         raise argparse.ArgumentTypeError(f"a percentage of the scene's diagonal must be below 100%, got {text!r}")
-    return value, relative
+    return Percent(value) if relative else value
 
 
 def _image_size(text: str) -> tuple[int, int | None]:
@@ -335,7 +340,7 @@ def _prepare_scene(args):
                          "with a \"camera\", or give --eps)")
     eps_text = None
     if args.eps is not None:
-        value, relative = args.eps
+        value, relative = float(args.eps), isinstance(args.eps, Percent)
         args.eps = value / 100 * scene.diagonal if relative else value
         eps_text = f"eps {args.eps:.6g}" + (f" = {value:g}% of the diagonal {scene.diagonal:.6g}" if relative else "")
         if not args.eps > 0:
