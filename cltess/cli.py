@@ -386,7 +386,7 @@ def _progress(args, what: str):
 def cmd_tessellate(args) -> int:
     """Load, tessellate, export, summarise."""
     from cltess.device import pick_device
-    from cltess.export import estimate_output_bytes
+    from cltess.export import estimate_output_bytes, estimate_write_seconds
     from cltess.limits import OutputTooLarge
     from cltess.stream import tessellate_to_file
 
@@ -411,8 +411,9 @@ def cmd_tessellate(args) -> int:
         _warn_saturated(int(plan.stats.get("saturated", 0)), args.max_factor)
         size = estimate_output_bytes(output.suffix, plan.num_vertices, plan.num_indices // 3, weld,
                                      args.uv == "seam")
+        seconds = estimate_write_seconds(output.suffix, size, plan.num_indices // 3, weld)
         what = (f"about {_human(size)} ({plan.num_vertices} vertices{' before welding' if weld else ''}, "
-                f"{plan.num_indices // 3} triangles)")
+                f"{plan.num_indices // 3} triangles; about {_duration(seconds)} to write)")
         if args.max_output is not None and size > args.max_output:
             raise OutputTooLarge(f"{output}: the output would be {what}, more than --max-output "
                                  f"{_human(args.max_output)}; check --eps (its units: the scene's diagonal is "
@@ -506,6 +507,14 @@ def _warn_saturated(saturated: int, max_factor: int) -> None:
         verb = "does" if saturated == 1 else "do"
         print(f"{PROG}: warning: {patches} --max-factor {max_factor} and {verb} not meet the error "
               "bound; raise --max-factor", file=sys.stderr)
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 1:
+        return "a second"
+    if seconds < 120:
+        return f"{seconds:.0f} s"
+    return f"{seconds / 60:.0f} min" if seconds < 7200 else f"{seconds / 3600:.0f} h"
 
 
 def _human(size: int) -> str:

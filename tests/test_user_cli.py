@@ -133,7 +133,7 @@ def test_saturation_warning_comes_before_anything_is_written(capsys, tmp_path):
 def test_large_outputs_are_announced_before_writing(capsys, tmp_path, monkeypatch):
     monkeypatch.setattr("cltess.cli.NOTE_OUTPUT_SIZE", 1000)
     code, out, err = run(capsys, "tessellate", SCENES / "teapot.bez", "--eps", "0.01", "-o", tmp_path / "t.ply")
-    assert code == 0 and "writing about" in err and "before welding" in err
+    assert code == 0 and "writing about" in err and "before welding" in err and "to write)" in err
     code, out, err = run(capsys, "tessellate", SCENES / "teapot.bez", "--eps", "0.01", "-q", "-o", tmp_path / "u.ply")
     assert code == 0 and err == "" and out == ""
 
