@@ -219,7 +219,7 @@ def build_parser() -> argparse.ArgumentParser:
     render = commands.add_parser(
         "render", help="tessellate a scene and draw it into a PNG (no display needed)",
         parents=[verbose, shared],
-        description="Tessellate a scene and draw it, flat shaded on the CPU, into a .png: front faces "
+        description="Tessellate a scene and draw it, shaded on the CPU, into a .png: front faces "
                     "grey-blue (or coloured by edge factor), back faces red. The view is the scene's "
                     "camera if it has one, else one that frames the scene (z up).",
     )
@@ -434,7 +434,8 @@ def cmd_tessellate(args) -> int:
         result = tessellate_to_file(
             tessellator, scene, output, max_memory_bytes=args.max_memory, weld=weld, uv=args.uv,
             on_plan=before_writing, progress=progress,
-            on_batch=(lambda batch: drawing.add(batch.positions, batch.triangles)) if drawing else None,
+            on_batch=(lambda batch: drawing.add(batch.positions, batch.triangles, normals=batch.normals))
+            if drawing else None,
             eps=args.eps, pixels=args.pixels, max_factor=args.max_factor, forward_differencing=not args.no_fd,
             **mesh_options)
     if drawing is not None:
@@ -489,7 +490,7 @@ def cmd_render(args) -> int:
             if args.color == "factor" and batch.num_triangles:
                 patch = batch.patch_ids[batch.triangles[:, 0]] - first
                 colours = factor_colours(batch.factors, patch, args.max_factor)
-            drawing.add(batch.positions, batch.triangles, colours)
+            drawing.add(batch.positions, batch.triangles, colours, batch.normals)
             if progress is not None:
                 progress("drawing", last, plan.num_patches)
     image = drawing.image()

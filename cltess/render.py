@@ -1,8 +1,8 @@
 """Pictures of a tessellation without a display: a small z-buffer rasteriser in NumPy and a PNG
 writer (zlib), so ``cltess render`` and ``--preview`` need nothing beyond the core install.
 
-Triangles are added in any number of blocks (a streamed run adds each batch), each is flat
-shaded by its own geometric normal: front faces (counter-clockwise on screen, the side the
+Triangles are added in any number of blocks (a streamed run adds each batch), shaded by their
+vertex normals interpolated across them (or flat): front faces (counter-clockwise on screen, the side the
 surface faces) in a light grey-blue, or coloured by edge factor; back faces in red, so an
 inside-out surface shows at a glance.  Rendered at twice the size and averaged 2 x 2 (anti-aliasing).
 
@@ -92,11 +92,14 @@ class Rasteriser:
         self.colour = np.tile(BACKGROUND, (self.width * self.height, 1))
         self.triangles = 0
 
-    def add(self, positions: np.ndarray, triangles: np.ndarray, colours: np.ndarray | None = None) -> None:
+    def add(self, positions: np.ndarray, triangles: np.ndarray, colours: np.ndarray | None = None,
+            normals: np.ndarray | None = None) -> None:
         """Draw triangles (T, 3) indexing positions (V, 3); colours (T, 3) in 0..1 for the front
-        faces (default a light grey-blue)."""
+        faces (default a light grey-blue); normals (V, 3): shade smoothly with them, interpolated
+        across each triangle (default: flat, each triangle's own normal)."""
         positions = np.asarray(positions, np.float64)
-        corners = positions[np.asarray(triangles, np.int64).reshape(-1, 3)]  # (T, 3, 3)
+        triangles = np.asarray(triangles, np.int64).reshape(-1, 3)
+        corners = positions[triangles]  # (T, 3, 3)
         if not len(corners):
             return
         matrix = self.view.matrix
@@ -107,23 +110,22 @@ class Rasteriser:
         with np.errstate(divide="ignore", invalid="ignore"):
             x = self.width / 2 + scale * camera[..., 0] / depth
             y = self.height / 2 - scale * camera[..., 1] / depth
-        normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-        length = np.linalg.norm(normal, axis=1, keepdims=True)
-        normal = np.where(length > 0, normal / np.where(length > 0, length, 1), 0)
-        normal_camera = normal @ matrix[:3, :3].T
-        # Lambert with a headlight and a key light from the upper left, in camera space.
-        key = np.array([-0.4, 0.6, 0.7]) / np.linalg.norm([-0.4, 0.6, 0.7])
-        view_ray = -camera.mean(axis=1)
-        view_ray /= np.maximum(np.linalg.norm(view_ray, axis=1, keepdims=True), 1e-300)
-        front = (normal_camera * view_ray).sum(axis=1) > 0
-        lit = np.abs((normal_camera * view_ray).sum(axis=1))
-        light = 0.25 + 0.5 * lit + 0.3 * np.clip(np.abs(normal_camera @ key), 0, 1)
+        face = _unit(np.cross(camera[:, 1] - camera[:, 0], camera[:, 2] - camera[:, 0]))
+        view_ray = _unit(-camera.mean(axis=1))
+        front = (face * view_ray).sum(axis=1) > 0
+        if normals is None:
+            corner_normals = np.repeat(face[:, None], 3, axis=1)
+        else:
+            corner_normals = np.asarray(normals, np.float64)[triangles] @ matrix[:3, :3].T
+        # shade the side that is seen: back faces with their normals turned towards the eye
+        corner_normals = np.where(front[:, None, None], corner_normals, -corner_normals)
         base = np.tile(FRONT, (len(corners), 1)) if colours is None else np.asarray(colours, np.float64)
-        shade = np.where(front[:, None], base, BACK) * light[:, None]
-        self._draw(x[visible], y[visible], 1 / depth[visible], np.clip(shade[visible], 0, 1))
+        base = np.where(front[:, None], base, BACK)
+        self._draw(x[visible], y[visible], 1 / depth[visible], base[visible], corner_normals[visible],
+                   view_ray[visible])
         self.triangles += int(visible.sum())
 
-    def _draw(self, x, y, inverse_depth, shade) -> None:
+    def _draw(self, x, y, inverse_depth, *shading) -> None:
         x0 = np.clip(np.floor(x.min(axis=1) - 0.5), 0, self.width).astype(np.int64)
         x1 = np.clip(np.ceil(x.max(axis=1) - 0.5), -1, self.width - 1).astype(np.int64)
         y0 = np.clip(np.floor(y.min(axis=1) - 0.5), 0, self.height).astype(np.int64)
@@ -136,10 +138,10 @@ class Rasteriser:
             # triangles start..stop-1 give about CANDIDATES_PER_BLOCK candidates (at least one triangle)
             base = ends[start - 1] if start else 0
             stop = max(int(np.searchsorted(ends, base + CANDIDATES_PER_BLOCK, side="right")), start + 1)
-            self._block(slice(start, stop), x, y, inverse_depth, shade, x0, y0, columns, counts)
+            self._block(slice(start, stop), x, y, inverse_depth, shading, x0, y0, columns, counts)
             start = stop
 
-    def _block(self, block, x, y, inverse_depth, shade, x0, y0, columns, counts) -> None:
+    def _block(self, block, x, y, inverse_depth, shading, x0, y0, columns, counts) -> None:
         count = counts[block]
         triangle = np.repeat(np.arange(block.start, block.stop), count)
         if not len(triangle):
@@ -163,7 +165,10 @@ class Rasteriser:
         depth = (w * inverse_depth[triangle]).sum(axis=1) / area
         np.maximum.at(self.inverse_depth, pixel, depth)
         won = depth >= self.inverse_depth[pixel]
-        self.colour[pixel[won]] = shade[triangle[won]]
+        base, corner_normals, view_ray = shading
+        triangle, weights = triangle[won], w[won] / area[won, None]
+        normal = _unit(np.einsum("nk,nkc->nc", weights, corner_normals[triangle]))
+        self.colour[pixel[won]] = np.clip(base[triangle] * _light(normal, view_ray[triangle])[:, None], 0, 1)
 
     def image(self) -> np.ndarray:
         """(height, width, 3) uint8, the supersampled buffer averaged down."""
@@ -172,11 +177,24 @@ class Rasteriser:
         return np.round(colour * 255).astype(np.uint8)
 
 
-def render(mesh, view: View, colours: np.ndarray | None = None) -> np.ndarray:
-    """(height, width, 3) uint8 image of a Tessellation or WeldedMesh (anything with positions
-    and triangles)."""
+KEY_LIGHT = np.array([-0.4, 0.6, 0.7]) / np.linalg.norm([-0.4, 0.6, 0.7])
+
+
+def _light(normal: np.ndarray, view_ray: np.ndarray) -> np.ndarray:
+    """Lambert in camera space: ambient, a headlight and a key light from the upper left."""
+    return 0.25 + 0.5 * np.abs((normal * view_ray).sum(axis=1)) + 0.3 * np.clip(normal @ KEY_LIGHT, 0, 1)
+
+
+def _unit(a: np.ndarray) -> np.ndarray:
+    length = np.linalg.norm(a, axis=-1, keepdims=True)
+    return np.where(length > 0, a / np.where(length > 0, length, 1), 0)
+
+
+def render(mesh, view: View, colours: np.ndarray | None = None, smooth: bool = True) -> np.ndarray:
+    """(height, width, 3) uint8 image of a Tessellation or WeldedMesh (anything with positions,
+    normals and triangles); smooth: shade with the vertex normals, else flat."""
     rasteriser = Rasteriser(view)
-    rasteriser.add(mesh.positions, mesh.triangles, colours)
+    rasteriser.add(mesh.positions, mesh.triangles, colours, mesh.normals if smooth else None)
     return rasteriser.image()
 
 

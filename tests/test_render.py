@@ -169,3 +169,15 @@ def test_big_guy_stored_inside_out_renders_right_side_out(capsys, tmp_path):
         assert code == 0, err
     assert red_fraction(read_png(tmp_path / "raw.png")) > 0.9
     assert red_fraction(read_png(tmp_path / "good.png")) < 0.1
+
+
+def test_vertex_normals_shade_smoothly_and_flat_without_them():
+    positions = np.array([[-1, -1, -1], [1, -1, -1], [-1, 1, -1]], float)
+    flat = Rasteriser(straight_view())
+    flat.add(positions, [[0, 1, 2]])
+    smooth = Rasteriser(straight_view())
+    smooth.add(positions, [[0, 1, 2]], normals=np.array([[0, 0, 1], [0.8, 0, 0.6], [0, 0.8, 0.6]]))
+    flat_image, smooth_image = flat.image(), smooth.image()
+    inside = covered(flat_image) & np.pad(covered(flat_image)[1:-1, 1:-1], 1)  # away from the anti-aliased rim
+    assert flat_image[inside].astype(float).std(axis=0).max() < 1
+    assert smooth_image[inside].astype(float).std(axis=0).max() > 5
