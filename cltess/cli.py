@@ -1,8 +1,12 @@
 """The ``cltess`` command line.
 
     cltess devices [--verbose]
-    cltess tessellate SCENE (--eps E | --pixels PX) [--no-fd] [--max-factor N] [--max-memory SIZE]
-                      [--sharp-edges {straight,average,keep}] [--device NAME] [--quiet] -o OUT
+    cltess tessellate SCENE (--eps E | --eps P% | --pixels PX) [--no-fd] [--max-factor N]
+                      [--max-memory SIZE] [--sharp-edges {straight,average,keep}] [--crease-angle DEG]
+                      [--no-orient] [--no-weld] [--uv {drop,seam}] [--max-output SIZE]
+                      [--preview PNG] [--device NAME] [--quiet] -o OUT
+    cltess render SCENE (--eps E | --eps P% | --pixels PX) [--size W[xH]] [--color {shade,factor}]
+                  [the scene options of tessellate] -o PNG
     cltess bench [SCENES...] [--device NAME] [--repeat N] [--warmup N] [--no-baseline] [--json OUT]
 
 Exit codes: 0 success, 1 OpenCL / device failure, 2 usage or input error, 130 interrupted
@@ -34,6 +38,8 @@ EXIT_OK, EXIT_DEVICE, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
 #: The stats printed on their own summary lines; any other int stat is listed after them.
 _MAIN_STATS = ("patches", "culled", "saturated", "vertices", "triangles")
+#: Bookkeeping of a batch, not of the result.
+_HIDDEN_STATS = ("first_patch", "last_patch")
 
 
 class UsageError(Exception):
@@ -536,7 +542,7 @@ def format_summary(stats: dict, stage_ms: dict, scene, device: str, tolerance: s
         ("triangles", stats.get("triangles", "?")),
     ]
     for name, value in stats.items():
-        if name not in _MAIN_STATS and isinstance(value, int) and not isinstance(value, bool):
+        if name not in _MAIN_STATS + _HIDDEN_STATS and isinstance(value, int) and not isinstance(value, bool):
             rows.append((name.replace("_", " "), value))
     if stage_ms:
         rows.append(("stage ms", ", ".join(f"{name} {ms:.3f}" for name, ms in stage_ms.items())))
