@@ -4,7 +4,14 @@
 >>> tess = Tessellator().tessellate(load_scene("scenes/teapot.bez"), eps=1e-3)
 >>> export(tess, "teapot.ply")
 """
+from importlib import metadata as _metadata
+
 from .runtimes import register_pip_runtimes
+
+try:
+    __version__ = _metadata.version("cltess")
+except _metadata.PackageNotFoundError:  # run from a source tree that was never installed
+    __version__ = "0+unknown"
 
 # Before anything lists OpenCL platforms: let the ICD loader see pip-installed CPU runtimes.
 register_pip_runtimes()
@@ -26,4 +33,5 @@ def __getattr__(name):
     raise AttributeError(name)
 
 
-__all__ = ["Camera", "Request", "Scene", "SceneError", "Tessellation", "Tessellator", "load_scene", "export"]
+__all__ = ["__version__", "Camera", "Request", "Scene", "SceneError", "Tessellation", "Tessellator", "load_scene",
+           "export"]

@@ -1,8 +1,12 @@
 """The ``cltess`` command line.
 
     cltess devices [--verbose]
-    cltess tessellate SCENE (--eps E | --pixels PX) [--no-fd] [--max-factor N] [--max-memory SIZE]
-                      [--sharp-edges {straight,average,keep}] [--device NAME] [--quiet] -o OUT
+    cltess tessellate SCENE (--eps E | --eps P% | --pixels PX) [--no-fd] [--max-factor N]
+                      [--max-memory SIZE] [--sharp-edges {straight,average,keep}] [--crease-angle DEG]
+                      [--no-orient] [--no-weld] [--uv {drop,seam}] [--max-output SIZE]
+                      [--preview PNG] [--device NAME] [--quiet] -o OUT
+    cltess render SCENE (--eps E | --eps P% | --pixels PX) [--size W[xH]] [--color {shade,factor}]
+                  [the scene options of tessellate] -o PNG
     cltess bench [SCENES...] [--device NAME] [--repeat N] [--warmup N] [--no-baseline] [--json OUT]
     cltess batch INPUTS... (--eps E | --pixels PX) -o OUTDIR [--format {ply,obj,npz}] [--split N]
                  [--scheduler ADDRESS] [--workers N] [tessellate's options]
@@ -25,14 +29,20 @@ import threading
 import warnings
 from pathlib import Path
 
-from cltess.export import SUPPORTED_EXTENSIONS, check_extension
+from cltess.export import MESH_FORMATS, SUPPORTED_EXTENSIONS, check_extension
+from cltess.scene import DEFAULT_CREASE_ANGLE
 
 PROG = "cltess"
 DEFAULT_MAX_FACTOR = 64
+DEFAULT_MAX_OUTPUT = 4 * 2**30  # --max-output: a wrong unit of --eps must not fill a disk
+NOTE_OUTPUT_SIZE = 64 * 2**20  # larger outputs are announced before they are written
+PROGRESS_DELAY = 1.0  # seconds before a progress bar appears: short runs print none
 EXIT_OK, EXIT_DEVICE, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
 #: The stats printed on their own summary lines; any other int stat is listed after them.
 _MAIN_STATS = ("patches", "culled", "saturated", "vertices", "triangles")
+#: Bookkeeping of a batch, not of the result.
+_HIDDEN_STATS = ("first_patch", "last_patch")
 
 
 class UsageError(Exception):
@@ -60,6 +70,40 @@ def _positive_float(text: str) -> float:
     return value
 
 
+class Percent(float):
+    """An --eps given as a percentage of the scene's bounding-box diagonal (its value: the
+    percentage); it becomes a distance once the scene is loaded."""
+
+
+def _tolerance(text: str) -> float:
+    """--eps: a distance, or a percentage of the scene's bounding-box diagonal ("0.1%")."""
+    relative = text.strip().endswith("%")
+    value = _positive_float(text.strip()[:-1] if relative else text)
+    if relative and value >= 100:
+        raise argparse.ArgumentTypeError(f"a percentage of the scene's diagonal must be below 100%, got {text!r}")
+    return Percent(value) if relative else value
+
+
+def _image_size(text: str) -> tuple[int, int | None]:
+    """'800' or '800x600': width and optional height, each 16..8192 pixels."""
+    parts = text.lower().split("x")
+    try:
+        if len(parts) > 2:
+            raise ValueError
+        sizes = [int(part) for part in parts]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an image size like 800 or 800x600: {text!r}") from None
+    if not all(16 <= size <= 8192 for size in sizes):
+        raise argparse.ArgumentTypeError(f"sizes must be 16..8192 pixels, got {text!r}")
+    return sizes[0], (sizes[1] if len(sizes) == 2 else None)
+
+
+def _output_cap(text: str) -> int | None:
+    if text.strip().lower() in ("none", "0"):
+        return None
+    return _memory_size(text)
+
+
 def _factor(text: str) -> int:
     try:
         value = int(text)
@@ -77,6 +121,16 @@ def _max_factor(text: str) -> int:
         return check_max_factor(_factor(text))
     except ValueError as error:
         raise argparse.ArgumentTypeError(str(error).removeprefix("max_factor ")) from None
+
+
+def _crease_angle(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number of degrees: {text!r}") from None
+    if not 0 <= value <= 180:  # NaN fails too
+        raise argparse.ArgumentTypeError(f"must be an angle in 0..180 degrees, got {text!r}")
+    return value
 
 
 def _memory_size(text: str) -> int:
@@ -117,36 +171,73 @@ def build_parser() -> argparse.ArgumentParser:
                     "($CLTESS_DEVICE, else the first usable CPU device, else the first usable device).",
     )
 
+    # What tessellate and render share: the scene and how it is tessellated.
+    shared = _Parser(add_help=False)
+    shared.add_argument("scene", metavar="SCENE", help="scene file: .bpt, .bez, .json or a triangle mesh")
+    tolerance = shared.add_mutually_exclusive_group(required=True)
+    tolerance.add_argument("--eps", type=_tolerance, metavar="E",
+                           help="object-space tolerance: max distance from surface to mesh, in scene units, "
+                                "or as a percentage of the scene's bounding-box diagonal (0.1%%)")
+    tolerance.add_argument("--pixels", type=_positive_float, metavar="PX",
+                           help="screen-space tolerance in pixels (needs a camera in the scene)")
+    shared.add_argument("--no-fd", action="store_true",
+                        help="evaluate every vertex directly instead of by forward differencing")
+    shared.add_argument("--max-factor", type=_max_factor, default=DEFAULT_MAX_FACTOR, metavar="N",
+                        help=f"largest edge factor per patch (default {DEFAULT_MAX_FACTOR})")
+    shared.add_argument("--device", metavar="NAME",
+                        help="OpenCL device: substring of platform or device name (default $CLTESS_DEVICE, "
+                             "else the first usable CPU device; see 'cltess devices')")
+    shared.add_argument("--max-memory", type=_memory_size, metavar="SIZE",
+                        help="cap on the memory the output may take at once (e.g. 512M, 2G); a larger "
+                             "output is tessellated in batches (streamed to a per-patch .ply or .obj). "
+                             "Default: half the device's memory")
+    shared.add_argument("--sharp-edges", choices=("straight", "average", "keep"), default="straight",
+                        help="meshes: an edge whose two sides have different vertex normals becomes a "
+                             "straight crease (default), a curve from the averaged normals, or keeps "
+                             "each side's own PN curve (may crack)")
+    shared.add_argument("--crease-angle", type=_crease_angle, default=DEFAULT_CREASE_ANGLE, metavar="DEG",
+                        help="meshes without normals in the file: edges whose faces meet at more than DEG "
+                             f"degrees stay sharp creases (default {DEFAULT_CREASE_ANGLE:g}; 180: all smooth)")
+    shared.add_argument("--orient", action=argparse.BooleanOptionalAction, default=True,
+                        help="turn patches to face one way across shared edges and outwards (signed volume); "
+                             "on by default, --no-orient leaves them as the file has them")
+    shared.add_argument("-q", "--quiet", action="store_true",
+                        help="print nothing on success, no progress bar (warnings still go to stderr)")
+
     run = commands.add_parser(
-        "tessellate", help="tessellate a scene and export the mesh", parents=[verbose],
+        "tessellate", help="tessellate a scene and export the mesh", parents=[verbose, shared],
         description="Tessellate a scene (.bpt, .bez or .json, or a triangle mesh as PN triangles: "
                     ".obj, .ply, .stl, .off, .glb, .gltf) and write the mesh "
                     f"({', '.join(SUPPORTED_EXTENSIONS)}).",
     )
-    run.add_argument("scene", metavar="SCENE", help="scene file: .bpt, .bez, .json or a triangle mesh")
-    tolerance = run.add_mutually_exclusive_group(required=True)
-    tolerance.add_argument("--eps", type=_positive_float, metavar="E",
-                           help="object-space tolerance: max distance from surface to mesh")
-    tolerance.add_argument("--pixels", type=_positive_float, metavar="PX",
-                           help="screen-space tolerance in pixels (needs a camera in the scene)")
-    run.add_argument("--no-fd", action="store_true",
-                     help="evaluate every vertex directly instead of by forward differencing")
-    run.add_argument("--max-factor", type=_max_factor, default=DEFAULT_MAX_FACTOR, metavar="N",
-                     help=f"largest edge factor per patch (default {DEFAULT_MAX_FACTOR})")
-    run.add_argument("--device", metavar="NAME",
-                     help="OpenCL device: substring of platform or device name (default $CLTESS_DEVICE, "
-                          "else the first usable CPU device; see 'cltess devices')")
-    run.add_argument("--max-memory", type=_memory_size, metavar="SIZE",
-                     help="cap on the memory the output may take at once (e.g. 512M, 2G); a larger "
-                          "output is tessellated in batches streamed to the file (.ply, .obj). "
-                          "Default: half the device's memory")
-    run.add_argument("--sharp-edges", choices=("straight", "average", "keep"), default="straight",
-                     help="meshes: an edge whose two sides have different vertex normals becomes a "
-                          "straight crease (default), a curve from the averaged normals, or keeps "
-                          "each side's own PN curve (may crack)")
+    run.add_argument("--weld", action=argparse.BooleanOptionalAction, default=None,
+                     help="write one indexed mesh per object, shared boundary vertices merged exactly "
+                          f"(default for {', '.join(MESH_FORMATS)}; --no-weld: every patch's own vertices, "
+                          "streamed in batches when large; .npz: the Tessellation's arrays unless --weld)")
+    run.add_argument("--uv", choices=("drop", "seam"), default="drop",
+                     help="welded output: drop the per-patch (u, v) (default) or keep them per triangle "
+                          "corner as a seam (.ply face texcoord, .obj vt)")
+    run.add_argument("--max-output", type=_output_cap, default=DEFAULT_MAX_OUTPUT, metavar="SIZE",
+                     help="refuse (before writing) an output file estimated larger than SIZE (e.g. 500M, 20G; "
+                          f"default {DEFAULT_MAX_OUTPUT // 2**30}G; none: no limit)")
+    run.add_argument("--preview", metavar="PNG",
+                     help="also draw the result into this .png (as 'cltess render' does)")
     run.add_argument("-o", "--output", required=True, metavar="OUT",
                      help=f"output mesh: {', '.join(SUPPORTED_EXTENSIONS)}")
-    run.add_argument("-q", "--quiet", action="store_true", help="print nothing on success (warnings still go to stderr)")
+
+    render = commands.add_parser(
+        "render", help="tessellate a scene and draw it into a PNG (no display needed)",
+        parents=[verbose, shared],
+        description="Tessellate a scene and draw it, shaded on the CPU, into a .png: front faces "
+                    "grey-blue (or coloured by edge factor), back faces red. The view is the scene's "
+                    "camera if it has one, else one that frames the scene (z up).",
+    )
+    render.add_argument("--size", type=_image_size, default=(800, None), metavar="W[xH]",
+                        help="image size in pixels (default 800 wide, the camera's aspect or 4:3)")
+    render.add_argument("--color", choices=("shade", "factor"), default="shade",
+                        help="front faces in one colour (shade, default) or by their patch's largest edge "
+                             "factor (factor: dark blue 1 to yellow --max-factor, log scale)")
+    render.add_argument("-o", "--output", required=True, metavar="PNG", help="output image (.png)")
 
     batch = commands.add_parser(
         "batch", help="tessellate many scenes (or one huge scene) on Dask workers", parents=[verbose],
@@ -247,41 +338,161 @@ def _check_output_path(path: Path) -> None:
         raise UsageError(f"{path}: folder {str(path.parent)!r} does not exist")
 
 
+def _inputs(scene_path: Path) -> list[Path]:
+    """The scene file and, for a JSON scene, the object files it names (as far as it parses)."""
+    import json
+    import stat
+
+    inputs = [scene_path]
+    if scene_path.suffix.lower() == ".json":
+        try:
+            if not stat.S_ISREG(os.stat(scene_path).st_mode):
+                return inputs  # a device or FIFO: never read here; the reader refuses it
+            objects = json.loads(scene_path.read_text()).get("objects", [])
+            inputs += [scene_path.parent / obj["file"] for obj in objects
+                       if isinstance(obj, dict) and isinstance(obj.get("file"), str)]
+        except (OSError, ValueError, AttributeError, TypeError, RecursionError):
+            pass  # the reader reports what is wrong with it
+    return inputs
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        return a.exists() and b.exists() and os.path.samefile(a, b) or a.resolve() == b.resolve()
+    except (OSError, RuntimeError, ValueError):
+        return False
+
+
+def _refuse_overwriting_an_input(output: Path, scene: str) -> None:
+    for source in _inputs(Path(scene)):
+        if _same_file(output, source):
+            raise UsageError(f"{output}: is an input of this run ({source}); choose another -o")
+
+
+def _prepare_scene(args):
+    """Load, orient and check the scene; turn a relative --eps into a distance.  Returns (scene,
+    orientation report or None, the tolerance as the summary shows it)."""
+    from cltess.formats import load_scene
+    from cltess.limits import eps_below_float32
+
+    scene = load_scene(args.scene, crease_angle=args.crease_angle)
+    orientation = None
+    if args.orient:
+        from cltess.orient import orient_scene
+
+        scene, orientation = orient_scene(scene)
+    if args.pixels is not None and scene.camera is None:
+        raise UsageError(f"{args.scene}: --pixels needs a camera in the scene (use a .json scene "
+                         "with a \"camera\", or give --eps)")
+    eps_text = None
+    if args.eps is not None:
+        value, relative = float(args.eps), isinstance(args.eps, Percent)
+        args.eps = value / 100 * scene.diagonal if relative else value
+        eps_text = f"eps {args.eps:.6g}" + (f" = {value:g}% of the diagonal {scene.diagonal:.6g}" if relative else "")
+        if not args.eps > 0:
+            raise UsageError(f"{args.scene}: --eps {value:g}% of the scene's diagonal is 0 (a scene of one point)")
+        too_fine = eps_below_float32(scene, args.eps)
+        if too_fine:
+            print(f"{PROG}: warning: {args.scene}: {too_fine}", file=sys.stderr)
+    tolerance = eps_text if args.eps is not None else f"{args.pixels:g} px"
+    return scene, orientation, tolerance
+
+
+def _check_preview(name: str, scene: str) -> Path:
+    path = Path(name)
+    if path.suffix.lower() != ".png":
+        raise UsageError(f"{path}: a preview is a .png image")
+    if path.is_dir() or not path.parent.is_dir():
+        raise UsageError(f"{path}: is a directory" if path.is_dir() else
+                         f"{path}: folder {str(path.parent)!r} does not exist")
+    _refuse_overwriting_an_input(path, scene)
+    return path
+
+
+def _progress(args, what: str):
+    """A progress callback (stage, done, total) drawing a tqdm bar on stderr that appears only
+    for runs longer than about a second, or None: with -q, or when stderr is not a terminal."""
+    if args.quiet or not sys.stderr.isatty():
+        return None, contextlib.nullcontext()
+    from tqdm import tqdm
+
+    bar = tqdm(total=1, desc=what, delay=PROGRESS_DELAY, file=sys.stderr, leave=False, unit="patch",
+               bar_format="{desc}: {percentage:3.0f}%|{bar}| {n_fmt}/{total_fmt} [{elapsed}]")
+
+    def update(stage, done, total):
+        if bar.total != total:
+            bar.total = total
+        bar.set_description_str(f"{what}: {stage}", refresh=False)
+        bar.n = done
+        bar.refresh()
+
+    return update, bar
+
+
 def cmd_tessellate(args) -> int:
     """Load, tessellate, export, summarise."""
     from cltess.device import pick_device
-    from cltess.formats import load_scene
-    from cltess.limits import eps_below_float32
+    from cltess.export import estimate_output_bytes, estimate_write_seconds
+    from cltess.limits import OutputTooLarge
     from cltess.stream import tessellate_to_file
 
     output = Path(args.output)
     _check_output_path(output)
-    scene = load_scene(args.scene)
-    if args.pixels is not None and scene.camera is None:
-        raise UsageError(f"{args.scene}: --pixels needs a camera in the scene (use a .json scene "
-                         "with a \"camera\", or give --eps)")
-    if args.eps is not None:
-        too_fine = eps_below_float32(scene, args.eps)
-        if too_fine:
-            print(f"{PROG}: warning: {args.scene}: {too_fine}", file=sys.stderr)
+    _refuse_overwriting_an_input(output, args.scene)
+    weld = args.weld if args.weld is not None else output.suffix.lower() in MESH_FORMATS
+    if args.uv == "seam" and not weld:
+        raise UsageError("--uv seam is for welded output (per-patch output keeps every vertex's (u, v))")
+    if args.uv == "seam" and output.suffix.lower() not in (".ply", ".obj", ".npz"):
+        raise UsageError(f"{output}: --uv seam can be written to .ply, .obj or .npz only")
+    preview = _check_preview(args.preview, args.scene) if args.preview else None
+    scene, orientation, eps_text = _prepare_scene(args)
     device = pick_device(args.device)
 
     from cltess.pipeline import Tessellator  # lazy: builds OpenCL programs
 
     tessellator = Tessellator(device=device)
     mesh_options = {"sharp_edges": args.sharp_edges} if scene.meshes else {}
-    result = tessellate_to_file(tessellator, scene, output, max_memory_bytes=args.max_memory, eps=args.eps,
-                                pixels=args.pixels, max_factor=args.max_factor,
-                                forward_differencing=not args.no_fd, **mesh_options)
+    def before_writing(plan):
+        """After stages 1-3, before anything big exists: warn, estimate, refuse."""
+        _warn_saturated(int(plan.stats.get("saturated", 0)), args.max_factor)
+        size = estimate_output_bytes(output.suffix, plan.num_vertices, plan.num_indices // 3, weld,
+                                     args.uv == "seam")
+        seconds = estimate_write_seconds(output.suffix, size, plan.num_indices // 3, weld)
+        what = (f"about {_human(size)} ({plan.num_vertices} vertices{' before welding' if weld else ''}, "
+                f"{plan.num_indices // 3} triangles; about {_duration(seconds)} to write)")
+        if args.max_output is not None and size > args.max_output:
+            raise OutputTooLarge(f"{output}: the output would be {what}, more than --max-output "
+                                 f"{_human(args.max_output)}; check --eps (its units: the scene's diagonal is "
+                                 f"{scene.diagonal:.6g}), or raise --max-output (or give --max-output none)")
+        if size >= NOTE_OUTPUT_SIZE and not args.quiet:
+            print(f"{PROG}: writing {what} to {output}", file=sys.stderr)
+
+        if progress is not None:
+            progress(f"writing {_human(size)}", 0, plan.num_patches)
+
+    drawing = None
+    if preview is not None:
+        from cltess.render import Rasteriser, view_for
+
+        drawing = Rasteriser(view_for(scene))
+    progress, bar = _progress(args, str(output))
+    with bar:
+        result = tessellate_to_file(
+            tessellator, scene, output, max_memory_bytes=args.max_memory, weld=weld, uv=args.uv,
+            on_plan=before_writing, progress=progress,
+            on_batch=(lambda batch: drawing.add(batch.positions, batch.triangles, normals=batch.normals))
+            if drawing else None,
+            eps=args.eps, pixels=args.pixels, max_factor=args.max_factor, forward_differencing=not args.no_fd,
+            **mesh_options)
+    if drawing is not None:
+        from cltess.render import write_png
+
+        write_png(preview, drawing.image())
     if result.batches > 1:
         result.stats["batches"] = result.batches
+    if orientation is not None:
+        result.stats.update(orientation.stats())
 
-    saturated = int(result.stats.get("saturated", 0))
-    if saturated:
-        patches = "1 patch reaches" if saturated == 1 else f"{saturated} patches reach"
-        verb = "does" if saturated == 1 else "do"
-        print(f"{PROG}: warning: {patches} --max-factor {args.max_factor} and {verb} not meet the error "
-              "bound; raise --max-factor", file=sys.stderr)
     if not int(result.stats.get("triangles", 0)):
         reasons = [f"{result.stats[key]} {label}" for key, label in
                    (("culled", "outside the camera's view"), ("folded_triangles", "folded mesh triangles"))
@@ -294,10 +505,71 @@ def cmd_tessellate(args) -> int:
               "curve, so the mesh may crack there; --sharp-edges straight or average keeps it closed",
               file=sys.stderr)
     if not args.quiet:
-        tolerance = f"eps {args.eps:g}" if args.eps is not None else f"{args.pixels:g} px"
         print(format_summary(result.stats, result.stage_ms, scene=args.scene, device=device.name.strip(),
-                             tolerance=tolerance, output=output))
+                             tolerance=eps_text, output=output if preview is None else f"{output}, {preview}"))
     return EXIT_OK
+
+
+def cmd_render(args) -> int:
+    """Tessellate in memory-bounded batches, draw each into one z-buffer, write the PNG."""
+    from cltess.device import pick_device
+    from cltess.render import Rasteriser, factor_colours, view_for, write_png
+    from cltess.stream import COPIES_IN_FLIGHT, default_budget
+
+    output = _check_preview(args.output, args.scene)
+    scene, orientation, tolerance = _prepare_scene(args)
+    device = pick_device(args.device)
+
+    from cltess.pipeline import Tessellator  # lazy: builds OpenCL programs
+
+    tessellator = Tessellator(device=device)
+    mesh_options = {"sharp_edges": args.sharp_edges} if scene.meshes else {}
+    plan = tessellator.plan(scene, eps=args.eps, pixels=args.pixels, max_factor=args.max_factor, **mesh_options)
+    _warn_saturated(int(plan.stats.get("saturated", 0)), args.max_factor)
+    budget = args.max_memory or default_budget(tessellator.device)
+    drawing = Rasteriser(view_for(scene, *args.size))
+    progress, bar = _progress(args, str(output))
+    with bar:
+        for first, last in plan.batch_ranges(max(budget // COPIES_IN_FLIGHT, 1)):
+            batch = tessellator.emit(plan, first, last, not args.no_fd)
+            colours = None
+            if args.color == "factor" and batch.num_triangles:
+                patch = batch.patch_ids[batch.triangles[:, 0]] - first
+                colours = factor_colours(batch.factors, patch, args.max_factor)
+            drawing.add(batch.positions, batch.triangles, colours, batch.normals)
+            if progress is not None:
+                progress("drawing", last, plan.num_patches)
+    image = drawing.image()
+    write_png(output, image)
+    if not args.quiet:
+        stats = dict(plan.stats, **(orientation.stats() if orientation else {}))
+        print(format_summary(stats, {}, scene=args.scene, device=device.name.strip(), tolerance=tolerance,
+                             output=f"{output} ({image.shape[1]}x{image.shape[0]})"))
+    return EXIT_OK
+
+
+def _warn_saturated(saturated: int, max_factor: int) -> None:
+    if saturated:
+        patches = "1 patch reaches" if saturated == 1 else f"{saturated} patches reach"
+        verb = "does" if saturated == 1 else "do"
+        print(f"{PROG}: warning: {patches} --max-factor {max_factor} and {verb} not meet the error "
+              "bound; raise --max-factor", file=sys.stderr)
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 1:
+        return "a second"
+    if seconds < 120:
+        return f"{seconds:.0f} s"
+    return f"{seconds / 60:.0f} min" if seconds < 7200 else f"{seconds / 3600:.0f} h"
+
+
+def _human(size: int) -> str:
+    """Bytes as 812 B, 3.4 MiB, 1.2 GiB."""
+    for unit, scale in (("GiB", 2**30), ("MiB", 2**20), ("KiB", 2**10)):
+        if size >= scale:
+            return f"{size / scale:.1f} {unit}"
+    return f"{size} B"
 
 
 def format_summary(stats: dict, stage_ms: dict, scene, device: str, tolerance: str, output) -> str:
@@ -310,7 +582,7 @@ def format_summary(stats: dict, stage_ms: dict, scene, device: str, tolerance: s
         ("triangles", stats.get("triangles", "?")),
     ]
     for name, value in stats.items():
-        if name not in _MAIN_STATS and isinstance(value, int) and not isinstance(value, bool):
+        if name not in _MAIN_STATS + _HIDDEN_STATS and isinstance(value, int) and not isinstance(value, bool):
             rows.append((name.replace("_", " "), value))
     if stage_ms:
         rows.append(("stage ms", ", ".join(f"{name} {ms:.3f}" for name, ms in stage_ms.items())))
@@ -388,7 +660,8 @@ def cmd_batch(args) -> int:
     return EXIT_OK
 
 
-_COMMANDS = {"devices": cmd_devices, "tessellate": cmd_tessellate, "bench": cmd_bench, "batch": cmd_batch}
+_COMMANDS = {"devices": cmd_devices, "tessellate": cmd_tessellate, "render": cmd_render, "bench": cmd_bench,
+             "batch": cmd_batch}
 
 
 # --------------------------------------------------------------------------- entry point

@@ -34,7 +34,7 @@ import numpy as np
 
 from .limits import float32_problem
 from .meshes import MESH_EXTENSIONS, read_mesh, read_mesh_scene
-from .scene import Camera, Scene, SceneError, check_scene_file
+from .scene import DEFAULT_CREASE_ANGLE, Camera, Scene, SceneError, check_scene_file
 
 __all__ = ["load_scene", "read_bpt", "read_bez", "read_json_scene", "write_bpt", "write_bez"]
 
@@ -51,13 +51,17 @@ _BPT_LINES_PER_PATCH = 17  # "3 3" + 16 points
 _INT32_MAX = 2**31 - 1
 
 
-def load_scene(path) -> Scene:
-    """Read a ``.bpt``, ``.bez``, ``.json`` or mesh scene; ``Scene.name`` is ``path`` as given."""
+def load_scene(path, crease_angle: float | None = DEFAULT_CREASE_ANGLE) -> Scene:
+    """Read a ``.bpt``, ``.bez``, ``.json`` or mesh scene; ``Scene.name`` is ``path`` as given.
+    crease_angle: degrees, for meshes without normals in the file (``TriangleMesh``): sharper
+    edges stay creases; None: every edge smooth."""
     ext = Path(path).suffix.lower()
     reader = _READERS.get(ext)
     if reader is None:
         raise SceneError(f"{path}: unknown scene extension {ext or '(none)'!r}; expected .bpt, .bez, .json "
                          f"or a triangle mesh ({', '.join(MESH_EXTENSIONS)})")
+    if ext == ".json" or ext in MESH_EXTENSIONS:
+        return reader(path, crease_angle=crease_angle)
     return reader(path)
 
 
@@ -299,7 +303,7 @@ def _indices(lines: _Lines, first: int, rows: list[list[str]], num_vertices: int
 # --------------------------------------------------------------------------- .json
 
 
-def read_json_scene(path) -> Scene:
+def read_json_scene(path, crease_angle: float | None = DEFAULT_CREASE_ANGLE) -> Scene:
     """A JSON scene: its objects' patches (transformed) concatenated, with object ids and camera."""
     name = str(path)
     text = _read_text(path)
@@ -343,7 +347,7 @@ def read_json_scene(path) -> Scene:
             resolved = file_path.resolve()
             if resolved not in cache:
                 if ext in MESH_EXTENSIONS:
-                    cache[resolved] = read_mesh(file_path)
+                    cache[resolved] = read_mesh(file_path, crease_angle=crease_angle)
                 else:
                     lines = _Lines.read(file_path)
                     cache[resolved] = _parse_bpt(lines) if ext == ".bpt" else _parse_bez(lines)

@@ -15,20 +15,21 @@ from pathlib import Path
 
 import numpy as np
 
-from .scene import Scene, SceneError, TriangleMesh, check_scene_file
+from .scene import DEFAULT_CREASE_ANGLE, Scene, SceneError, TriangleMesh, check_scene_file
 
 __all__ = ["MESH_EXTENSIONS", "read_mesh", "read_mesh_scene"]
 
 MESH_EXTENSIONS = (".obj", ".ply", ".stl", ".off", ".glb", ".gltf")
 
 
-def read_mesh_scene(path) -> Scene:
+def read_mesh_scene(path, crease_angle: float | None = DEFAULT_CREASE_ANGLE) -> Scene:
     """A mesh file as a scene of one mesh (object id 0); patch ids are its face indices."""
-    return Scene.from_meshes([read_mesh(path)], name=str(path))
+    return Scene.from_meshes([read_mesh(path, crease_angle=crease_angle)], name=str(path))
 
 
-def read_mesh(path, object_id: int = 0) -> TriangleMesh:
-    """One mesh file as a TriangleMesh (checked and repaired: see TriangleMesh)."""
+def read_mesh(path, object_id: int = 0, crease_angle: float | None = DEFAULT_CREASE_ANGLE) -> TriangleMesh:
+    """One mesh file as a TriangleMesh (checked and repaired: see TriangleMesh).  Where the file
+    has no normals, edges sharper than ``crease_angle`` degrees stay creases (None: all smooth)."""
     import trimesh
 
     name = str(path)
@@ -52,7 +53,7 @@ def read_mesh(path, object_id: int = 0) -> TriangleMesh:
         normals = np.asarray(loaded.vertex_normals) if _has_normals(loaded) else None
     else:
         raise SceneError(f"{name}: the mesh has no faces (read as a {type(loaded).__name__})")
-    return TriangleMesh(vertices, faces, normals, object_id, name)
+    return TriangleMesh(vertices, faces, normals, object_id, name, crease_angle)
 
 
 def _check_binary_stl(file: Path, name: str) -> None:

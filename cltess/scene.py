@@ -144,6 +144,46 @@ def vertex_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     return _unit_rows(total)[welded]
 
 
+#: Edges whose faces' normals differ by more than this many degrees stay sharp when a mesh file
+#: has no normals.  Between Blender's auto-smooth 30 and 3ds Max's 45: a 12-sided cylinder or
+#: torus (30 degrees between facets), the coarse meshes PN triangles are for, stays round; a
+#: 45-degree chamfer and a cube's edges stay sharp.
+DEFAULT_CREASE_ANGLE = 40.0
+
+
+def creased_normals(vertices: np.ndarray, faces: np.ndarray, crease_angle: float) -> np.ndarray:
+    """(F, 3, 3) normal per face corner: the angle-weighted face normals (as
+    :func:`vertex_normals`) of the faces around the corner's welded position whose normal is
+    within ``crease_angle`` degrees of the corner's own face's (three.js ``toCreasedNormals``).
+    Corners on one smooth region get bitwise the same normal (the same sum in the same order);
+    across an edge sharper than the angle they differ, and the PN pipeline keeps it a crease."""
+    vertices = np.asarray(vertices, np.float64)
+    faces = np.asarray(faces, np.int64)
+    corners = vertices[faces]
+    normal = _unit_rows(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]))
+    angles = np.zeros(faces.shape)
+    for c in range(3):
+        a = _unit_rows(corners[:, (c + 1) % 3] - corners[:, c])
+        b = _unit_rows(corners[:, (c + 2) % 3] - corners[:, c])
+        angles[:, c] = np.arccos(np.clip((a * b).sum(1), -1.0, 1.0))
+    # every pair (corner k, corner l) at one welded position: sum(s^2) pairs over the positions
+    at = weld_positions(vertices)[faces].reshape(-1)
+    order = np.argsort(at, kind="stable")
+    sizes = np.bincount(at)
+    starts = np.concatenate([[0], np.cumsum(sizes)])[at[order]]
+    count = sizes[at[order]]
+    k = np.repeat(order, count)
+    l = order[np.repeat(starts, count) + np.arange(len(k)) - np.repeat(np.cumsum(count) - count, count)]
+    face_k, face_l = k // 3, l // 3
+    cos_limit = np.cos(np.radians(min(max(float(crease_angle), 0.0), 180.0)))
+    smooth = (normal[face_k] * normal[face_l]).sum(axis=1) >= cos_limit - 1e-12
+    smooth |= (face_k == face_l) | ~normal[face_k].any(axis=1)  # a sliver's corner takes every side
+    k, l = k[smooth], l[smooth]
+    weighted = normal[l // 3] * angles.reshape(-1)[l][:, None]
+    total = np.stack([np.bincount(k, weighted[:, axis], minlength=3 * len(faces)) for axis in range(3)], axis=1)
+    return _unit_rows(total).reshape(-1, 3, 3)
+
+
 def weld_positions(vertices: np.ndarray) -> np.ndarray:
     """(V,) id per vertex, equal for vertices at bitwise the same float32 position (the device's
     view of them; -0.0 = 0.0): the welding PN adjacency uses."""
@@ -172,6 +212,10 @@ class TriangleMesh:
                (:func:`vertex_normals`: angle-weighted, over the welded positions).
     object_id: the object id of every vertex of its tessellation.
     name:      for messages.
+    crease_angle: degrees, or None.  Only where ``normals`` is None: edges whose faces' normals
+               differ by more than this get a normal per side (:func:`creased_normals`; the
+               vertices there are split, faces keep their order), so the PN surface keeps them
+               as creases; None: one averaged normal per position (every edge smooth).
 
     ``degenerate_triangles`` counts faces of (near) zero area.  They are kept: a PN triangle
     over a sliver is still a well-defined patch between its neighbours' curves, and dropping it
@@ -185,6 +229,7 @@ class TriangleMesh:
     normals: np.ndarray | None = None
     object_id: int = 0
     name: str = "<mesh>"
+    crease_angle: float | None = None
     normals_from_file: bool = field(init=False, default=False)
     repaired_normals: int = field(init=False, default=0)
     degenerate_triangles: int = field(init=False, default=0)
@@ -227,7 +272,17 @@ class TriangleMesh:
 
         computed = None
         self.normals_from_file = self.normals is not None
-        if self.normals is None:
+        if self.normals is None and self.crease_angle is not None:
+            if not 0 <= float(self.crease_angle) <= 180:
+                raise SceneError(f"{name}: crease angle must be in 0..180 degrees, got {self.crease_angle!r}")
+            # a vertex per distinct (position, corner normal); faces keep their order
+            corner_normals = creased_normals(vertices, faces, self.crease_angle).reshape(-1, 3)
+            keys = np.hstack([vertices[faces].reshape(-1, 3), corner_normals])
+            _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+            vertices, faces = vertices[faces].reshape(-1, 3)[first], inverse.reshape(-1, 3).astype(np.int64)
+            self.vertices, self.faces = vertices.copy(), faces.copy()
+            normals = corner_normals[first]
+        elif self.normals is None:
             normals = computed = vertex_normals(vertices, faces)
         else:
             normals = np.array(self.normals, dtype=np.float64)
@@ -369,6 +424,21 @@ class Scene:
     def from_trimesh(mesh, camera: Camera | None = None, name: str = "<trimesh>", object_id: int = 0) -> "Scene":
         """A scene of one ``trimesh.Trimesh`` (see TriangleMesh.from_trimesh for its normals)."""
         return Scene.from_meshes([TriangleMesh.from_trimesh(mesh, object_id, name)], camera, name)
+
+    def bounding_box(self) -> tuple[np.ndarray, np.ndarray]:
+        """(lo (3,), hi (3,)) of every Bézier control point and mesh vertex: it holds the
+        surfaces (convex hull property; PN triangles stay near their vertices)."""
+        points = [self.points.reshape(-1, 3)] + [np.asarray(m.vertices) for m in self.meshes]
+        points = np.concatenate(points) if points else np.zeros((0, 3))
+        if not len(points):
+            return np.zeros(3), np.zeros(3)
+        return points.min(axis=0), points.max(axis=0)
+
+    @property
+    def diagonal(self) -> float:
+        """Length of the bounding box's diagonal (what ``--eps 0.1%`` is a fraction of)."""
+        lo, hi = self.bounding_box()
+        return float(np.linalg.norm(hi - lo))
 
     @property
     def weights(self) -> np.ndarray:

@@ -43,29 +43,46 @@ def default_budget(device: cl.Device) -> int:
 
 
 def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = None,
+                       weld: bool = False, uv: str = "drop", on_plan=None, on_batch=None, progress=None,
                        **options) -> StreamResult:
-    """Tessellate ``scene`` into ``path`` (.ply, .obj or .npz) within ``max_memory_bytes``.
+    """Tessellate ``scene`` into ``path`` (.ply, .obj, .stl, .glb or .npz) within ``max_memory_bytes``.
 
     options: eps / pixels / max_factor / forward_differencing, as for ``Tessellator.tessellate``.
-    A .npz file cannot be streamed: it must fit the budget in one batch.
+    weld: write one welded mesh (``cltess.weld``; ``uv`` "drop" or "seam"): it is built in
+    memory, so it must fit the budget in one batch, as must .stl, .glb and .npz output; .ply
+    and .obj without weld are streamed batch by batch.  on_plan(plan): called after stages 1-3,
+    before anything big is allocated or written (to check or refuse the output size).
+    on_batch(tess): called with each batch's Tessellation (per-patch vertices, before welding),
+    e.g. to draw a preview.
+    progress(stage, done, total): called as batches are written.
     """
     path = Path(path)
     extension = check_extension(path)
     budget = max_memory_bytes or default_budget(tessellator.device)
     forward_differencing = options.pop("forward_differencing", True)
     plan = tessellator.plan(scene, **options)
+    if on_plan is not None:
+        on_plan(plan)
     try:
         ranges = plan.batch_ranges(max(budget // COPIES_IN_FLIGHT, 1))
     except OutputTooLarge as error:
         raise OutputTooLarge(f"{error} (a batch may take a third of the memory cap, {budget} bytes)") from None
-    if extension not in STREAMING_WRITERS:
+    if weld or extension not in STREAMING_WRITERS:
         if len(ranges) > 1:
+            why = "a welded mesh is built in memory" if weld else f"{extension} cannot be streamed"
+            fix = "give --no-weld to stream per-patch .ply or .obj" if weld else "write .ply or .obj"
             raise OutputTooLarge(f"{path}: the output ({plan.output_bytes} bytes) needs {len(ranges)} batches "
-                              f"under a budget of {budget} bytes, and {extension} cannot be streamed; "
-                              "write .ply or .obj, or raise the memory cap")
+                                 f"under a budget of {budget} bytes, and {why}; {fix}, or raise the memory cap")
         tess = tessellator.emit(plan, 0, plan.num_patches, forward_differencing)
-        export(tess, path)
-        return StreamResult(tess.stats, tess.stage_ms, 1, budget, path, ranges)
+        if progress is not None:
+            progress("tessellated", 1, 1)
+        if on_batch is not None:
+            on_batch(tess)
+        result = tess.welded(uv=uv) if weld else tess
+        if progress is not None and weld:
+            progress("welded", 1, 1)
+        export(result, path)
+        return StreamResult(result.stats, tess.stage_ms, 1, budget, path, ranges)
 
     stage_ms: dict = {}
     done = []
@@ -74,7 +91,11 @@ def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = 
             for batch in _emit_fitting(tessellator, plan, first, last, forward_differencing):
                 writer.write_vertices(batch)
                 writer.write_faces(batch.triangles)
+                if on_batch is not None:
+                    on_batch(batch)
                 done.append((batch.stats["first_patch"], batch.stats["last_patch"]))
+                if progress is not None:
+                    progress("batches", batch.stats["last_patch"], plan.num_patches)
                 for stage, ms in batch.stage_ms.items():
                     stage_ms[stage] = ms if stage == "total_wall" else stage_ms.get(stage, 0.0) + ms
                 del batch

@@ -54,3 +54,17 @@ class Tessellation:
     @property
     def num_triangles(self) -> int:
         return len(self.triangles)
+
+    def welded(self, uv: str = "drop", check_t_junctions: bool = True):
+        """One indexed mesh per object, shared boundary vertices merged exactly
+        (:func:`cltess.weld.weld`; ``uv="seam"`` keeps the per-patch (u, v) per triangle corner)."""
+        from .weld import weld
+
+        return weld(self, uv=uv, check_t_junctions=check_t_junctions)
+
+    def to_trimesh(self, weld: bool = True):
+        """A ``trimesh.Trimesh``: welded (watertight where the surface is closed) by default, else
+        the per-patch vertices as they are."""
+        from .export import to_trimesh
+
+        return to_trimesh(self.welded(check_t_junctions=False) if weld else self)

@@ -265,13 +265,23 @@ def tea_table_scene() -> tuple[list[dict], dict]:
     return objects, camera
 
 
+def write_sample_mesh(path: Path) -> None:
+    """A coarse 12-sided cylinder (radius 1, height 2, 48 triangles) as binary STL, the sample
+    triangle mesh: no normals in the file, 30 degrees between side facets (smooth under the
+    default --crease-angle 40), 90 degrees at the rims (kept sharp)."""
+    import trimesh
+
+    trimesh.creation.cylinder(radius=1.0, height=2.0, sections=12).export(path)
+
+
 def main() -> None:
+    write_sample_mesh(HERE / "cylinder.stl")
     write_bpt(HERE / "sphere.bpt", sphere_patches())
     write_bpt(HERE / "torus.bpt", torus_patches())
     write_bpt(HERE / "table.bpt", grid_patches(**TABLE))
     dump_scene(HERE / "teapots.json", *teapots_scene())
     dump_scene(HERE / "tea_table.json", *tea_table_scene())
-    for name in ("sphere.bpt", "torus.bpt", "table.bpt", "teapots.json", "tea_table.json"):
+    for name in ("cylinder.stl", "sphere.bpt", "torus.bpt", "table.bpt", "teapots.json", "tea_table.json"):
         print(f"wrote scenes/{name}")
 
 

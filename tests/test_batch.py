@@ -248,7 +248,8 @@ def test_cli_batch_split_writes_what_tessellate_writes(client, capsys, tmp_path)
                                tmp_path / "out", "--scheduler", client.scheduler.address)
     assert code == 0, stderr
     assert "1 done, 0 up to date, 0 failed" in stdout
-    code, _, stderr = run(capsys, "tessellate", SCENES / "teacup.bez", "--eps", 1e-3, "-o", tmp_path / "one.ply", "-q")
+    code, _, stderr = run(capsys, "tessellate", SCENES / "teacup.bez", "--eps", 1e-3, "--no-weld", "--no-orient",
+                         "-o", tmp_path / "one.ply", "-q")
     assert code == 0, stderr
     assert (tmp_path / "out" / "teacup.bez.ply").read_bytes() == (tmp_path / "one.ply").read_bytes()
     assert read_manifest(tmp_path / "out")["rows"][0]["parts"] == 3

@@ -221,9 +221,9 @@ def test_unknown_output_extension_checked_before_loading(capsys, tmp_path, monke
         raise AssertionError("scene loaded before the output path was checked")
 
     monkeypatch.setattr(cltess.formats, "load_scene", must_not_load)
-    code, _, err = run(capsys, "tessellate", tmp_path / "any.bpt", "--eps", "1e-3", "-o", tmp_path / "out.stl")
+    code, _, err = run(capsys, "tessellate", tmp_path / "any.bpt", "--eps", "1e-3", "-o", tmp_path / "out.3ds")
     assert code == 2
-    assert_clean_error(err, ".stl", ".ply")
+    assert_clean_error(err, ".3ds", ".ply")
     assert list(tmp_path.iterdir()) == []
 
 

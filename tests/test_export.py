@@ -278,7 +278,7 @@ def test_streaming_checks_declared_totals(tess, tmp_path):
 # --------------------------------------------------------------------------- errors, atomicity
 
 
-@pytest.mark.parametrize("name", ["mesh.stl", "mesh", "mesh.ply.gz"])
+@pytest.mark.parametrize("name", ["mesh.3ds", "mesh", "mesh.ply.gz"])
 def test_unknown_extension_writes_nothing(tess, tmp_path, name):
     with pytest.raises(ValueError) as error:
         export(tess, tmp_path / name)

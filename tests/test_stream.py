@@ -21,7 +21,7 @@ PEAK_RSS = r"""
 import re, sys
 from pathlib import Path
 from cltess.cli import main
-code = main(["tessellate"] + sys.argv[1:] + ["-q"])
+code = main(["tessellate"] + sys.argv[1:] + ["-q", "--no-weld"])  # per-patch output streams
 # VmHWM, not ru_maxrss: Linux carries ru_maxrss over execve from the parent process.
 print(int(re.search(r"VmHWM:\s+(\d+) kB", Path("/proc/self/status").read_text()).group(1)) * 1024)
 sys.exit(code)
