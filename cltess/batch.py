@@ -33,12 +33,12 @@ import sys
 import tempfile
 import time
 import warnings
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
-from .export import SUPPORTED_EXTENSIONS, atomic_write, ply_face_records, ply_header, ply_vertex_records
+from .export import MESH_FORMATS, SUPPORTED_EXTENSIONS, atomic_write, ply_face_records, ply_header, ply_vertex_records
 from .meshes import MESH_EXTENSIONS
 from .criteria.base import DEFAULT_MAX_FACTOR
 
@@ -68,6 +68,8 @@ class BatchOptions:
     device: str | None = None
     max_memory: int | None = None
     check_bound: bool = False  # measure each output's worst error / tolerance (cltess.bound)
+    weld: bool | None = None  # as tessellate --weld: None welds the mesh formats (MESH_FORMATS)
+    orient: bool = True  # as tessellate --orient (cltess.orient)
 
     def __post_init__(self):
         if (self.eps is None) == (self.pixels is None):
@@ -75,13 +77,21 @@ class BatchOptions:
         if f".{self.format}" not in SUPPORTED_EXTENSIONS:
             raise ValueError(f"unknown output format {self.format!r}; "
                              f"supported: {', '.join(e[1:] for e in SUPPORTED_EXTENSIONS)}")
+        if self.check_bound and self.welded:
+            raise ValueError("the bound is measured on per-patch output (its vertices keep their patch and "
+                             "(u, v)); add --no-weld (weld=False) to --check-bound")
+
+    @property
+    def welded(self) -> bool:
+        """Whether outputs are welded: ``weld``, else the default of ``cltess tessellate``."""
+        return self.weld if self.weld is not None else f".{self.format}" in MESH_FORMATS
 
     def output_key(self) -> dict:
         """What the output bytes depend on (not the device choice nor the memory cap), with the
         cltess version: a rerun redoes an input whose key differs."""
         return {"eps": self.eps, "pixels": self.pixels, "max_factor": self.max_factor,
                 "forward_differencing": self.forward_differencing, "sharp_edges": self.sharp_edges,
-                "format": self.format, "cltess": _version()}
+                "format": self.format, "weld": self.welded, "orient": self.orient, "cltess": _version()}
 
     def tessellation_kwargs(self) -> dict:
         return {"eps": self.eps, "pixels": self.pixels, "max_factor": self.max_factor,
@@ -308,7 +318,6 @@ def _worker_name() -> str:
 
 def tessellate_file_task(path: str, output: str, options: BatchOptions, slots: dict) -> dict:
     """On a worker: tessellate one input into ``output``; its manifest row, failed or not."""
-    from .formats import load_scene
     from .stream import tessellate_to_file
 
     started = time.perf_counter()
@@ -316,14 +325,15 @@ def tessellate_file_task(path: str, output: str, options: BatchOptions, slots: d
     row = _row(path, output, options.output_key(), worker=_worker_name())
     try:
         row["fingerprint"] = fingerprint(path)
-        scene = load_scene(path)
+        scene = _load(path, options)
         tessellator = _worker_tessellator(options.device, slots)
         row["device"] = tessellator.device.name.strip()
         kwargs = options.tessellation_kwargs()
         if not scene.meshes:
             kwargs.pop("sharp_edges")
         output.parent.mkdir(parents=True, exist_ok=True)
-        result = tessellate_to_file(tessellator, scene, output, max_memory_bytes=options.max_memory, **kwargs)
+        result = tessellate_to_file(tessellator, scene, output, max_memory_bytes=options.max_memory,
+                                    weld=options.welded, **kwargs)
         row.update(_counts(result.stats), status="done", output_bytes=output.stat().st_size,
                    parts=result.batches, **{f"{s}_ms": result.stage_ms.get(s) for s in STAGE_COLUMNS})
         if options.check_bound:
@@ -409,13 +419,21 @@ def _worker_budget(tessellator, options: BatchOptions) -> int:
     return max((options.max_memory or default_budget(tessellator.device)) // COPIES_IN_FLIGHT, 1)
 
 
+def _load(path, options: BatchOptions):
+    """The scene as ``cltess tessellate`` prepares it: read, then oriented unless told not to."""
+    from .formats import load_scene
+    from .orient import orient_scene
+
+    scene = load_scene(path)
+    return orient_scene(scene)[0] if options.orient else scene
+
+
 def plan_task(path: str, options: BatchOptions, slots: dict):
     """On a worker: load the scene and run stages 1-3 once; the HostPlan (kept on the
     cluster) and its stage times."""
-    from .formats import load_scene
     from .backends.opencl.tessellator import _span_ms
 
-    scene = load_scene(path)
+    scene = _load(path, options)
     tessellator = _worker_tessellator(options.device, slots)
     kwargs = options.tessellation_kwargs()
     kwargs.pop("forward_differencing")
@@ -640,6 +658,11 @@ def tessellate_files(inputs, outdir, options: BatchOptions | None = None, *, cli
         raise ValueError(f"a split scene is joined as PLY; --format {options.format} cannot be split")
     if split is not None and options.check_bound:
         raise ValueError("--check-bound measures whole outputs on one worker; it cannot be used with --split")
+    if split is not None:
+        if options.weld:
+            raise ValueError("a split scene is written per patch, not welded (welding needs the whole mesh in "
+                             "one memory); --weld cannot be used with --split")
+        options = replace(options, weld=False)
     outdir.mkdir(parents=True, exist_ok=True)
     key = options.output_key()
     previous = {row.get("input"): row for row in read_manifest(outdir)["rows"]}
@@ -697,13 +720,18 @@ def tessellate_split(scene, output, options: BatchOptions | None = None, *, part
                      client=None, scheduler: str | None = None, workers: int | None = None,
                      progress: bool | Progress = False, **option_fields) -> dict:
     """One scene file across the workers (module docstring) into the PLY ``output``: the same
-    file, byte for byte, as ``cltess tessellate`` writes.  ``parts``: patch ranges (default
+    file, byte for byte, as ``cltess tessellate --no-weld`` writes (a split scene is written per
+    patch: welding needs the whole mesh in one memory).  ``parts``: patch ranges (default
     4 per worker, more where a range would not fit a worker's memory cap).  Returns its
     manifest row; raises on failure (nothing is left at ``output``)."""
     options = options or BatchOptions(**option_fields)
     output = Path(output)
     if output.suffix.lower() != ".ply" or options.format != "ply":
         raise ValueError(f"{output}: a split scene is joined as PLY (.ply)")
+    if options.weld:
+        raise ValueError(f"{output}: a split scene is written per patch, not welded (welding needs the "
+                         "whole mesh in one memory); leave out weld")
+    options = replace(options, weld=False)
     bar = progress if isinstance(progress, Progress) else Progress(enabled=bool(progress))
     with contextlib.ExitStack() as stack:
         if client is None:

@@ -262,6 +262,11 @@ def build_parser() -> argparse.ArgumentParser:
                        help="output a worker may hold at once (default: half its device's memory)")
     batch.add_argument("--format", choices=[e[1:] for e in SUPPORTED_EXTENSIONS], default="ply",
                        help="output format (default ply): OUTDIR/NAME.EXT for an input NAME.EXT")
+    batch.add_argument("--weld", action=argparse.BooleanOptionalAction, default=None,
+                       help="as for tessellate: one welded mesh per output (default for "
+                            f"{', '.join(MESH_FORMATS)}; not with --split, which writes per patch)")
+    batch.add_argument("--orient", action=argparse.BooleanOptionalAction, default=True,
+                       help="as for tessellate: patches turned consistently and outwards (default)")
     batch.add_argument("--split", type=_factor, metavar="N",
                        help="tessellate each input across all workers in about N patch ranges, joined into "
                             "one PLY (for a scene too large for one worker)")
@@ -272,7 +277,8 @@ def build_parser() -> argparse.ArgumentParser:
                             "several, else one per CPU core)")
     batch.add_argument("--check-bound", action="store_true",
                        help="measure each output's worst distance to the surface / tolerance into the "
-                            "manifest (NumPy, on a sample of its triangles; .ply and .npz, not with --split)")
+                            "manifest (NumPy, on a sample of its triangles; .ply and .npz with --no-weld, "
+                            "not with --split)")
     batch.add_argument("-o", "--output", required=True, metavar="OUTDIR", help="output folder")
     batch.add_argument("-q", "--quiet", action="store_true", help="no progress bar or summary on success")
 
@@ -632,7 +638,7 @@ def cmd_batch(args) -> int:
     options = BatchOptions(eps=args.eps, pixels=args.pixels, max_factor=args.max_factor,
                            forward_differencing=not args.no_fd, sharp_edges=args.sharp_edges,
                            format=args.format, device=args.device, max_memory=args.max_memory,
-                           check_bound=args.check_bound)
+                           check_bound=args.check_bound, weld=args.weld, orient=args.orient)
     try:
         rows = tessellate_files(args.inputs, args.output, options, scheduler=args.scheduler,
                                 workers=args.workers, split=args.split, progress=Progress(enabled=not args.quiet))

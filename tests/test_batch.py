@@ -19,6 +19,7 @@ from cltess.batch import (BatchOptions, dask_client, expand_inputs, read_manifes
                           split_ranges, tessellate_files, tessellate_split)
 from cltess.cli import main  # noqa: E402
 from cltess.formats import load_scene  # noqa: E402
+from cltess.orient import orient_scene  # noqa: E402
 from cltess.stream import tessellate_to_file  # noqa: E402
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
@@ -49,9 +50,10 @@ def inputs(tmp_path):
     return folder
 
 
-def single_process_bytes(tessellator, path, tmp_path, **options) -> bytes:
+def single_process_bytes(tessellator, path, tmp_path, weld=True, **options) -> bytes:
+    """What ``cltess tessellate`` writes: the scene oriented, the mesh welded unless told not."""
     out = tmp_path / f"single-{Path(path).name}.ply"
-    tessellate_to_file(tessellator, load_scene(path), out, **options)
+    tessellate_to_file(tessellator, orient_scene(load_scene(path))[0], out, weld=weld, **options)
     return out.read_bytes()
 
 
@@ -109,17 +111,21 @@ def test_check_bound_measures_each_output_as_the_tests_do(client, inputs, tmp_pa
     from support import bound_ratio
 
     files = [inputs / "teapot.bez", inputs / "sphere.bpt"]
-    rows = tessellate_files(files, tmp_path / "out", eps=EPS, client=client, check_bound=True)
+    with pytest.raises(ValueError, match="--no-weld"):
+        tessellate_files(files, tmp_path / "welded", eps=EPS, client=client, check_bound=True)
+    rows = tessellate_files(files, tmp_path / "out", eps=EPS, client=client, check_bound=True, weld=False)
     for path, row in zip(files, rows):
         scene = load_scene(path)
         expected = bound_ratio(np.asarray(scene.patches, float), tessellator.tessellate(scene, eps=EPS), EPS, order=4)
         assert row["worst_bound_ratio"] == pytest.approx(expected, rel=1e-12)
         assert 0.1 < row["worst_bound_ratio"] <= 1
-    rows = tessellate_files(files[:1], tmp_path / "out", eps=EPS, client=client, check_bound=True)
+    rows = tessellate_files(files[:1], tmp_path / "out", eps=EPS, client=client, check_bound=True, weld=False)
     assert rows[0]["status"] == "skipped" and rows[0]["worst_bound_ratio"] is not None
-    [npz] = tessellate_files(files[:1], tmp_path / "npz", eps=EPS, client=client, check_bound=True, format="npz")
+    [npz] = tessellate_files(files[:1], tmp_path / "npz", eps=EPS, client=client, check_bound=True, format="npz",
+                             weld=False)
     assert npz["worst_bound_ratio"] == rows[0]["worst_bound_ratio"]
-    [obj] = tessellate_files(files[:1], tmp_path / "obj", eps=EPS, client=client, check_bound=True, format="obj")
+    [obj] = tessellate_files(files[:1], tmp_path / "obj", eps=EPS, client=client, check_bound=True, format="obj",
+                             weld=False)
     assert obj["status"] == "done" and obj["worst_bound_ratio"] is None
 
 
@@ -146,7 +152,8 @@ def test_split_scene_is_byte_identical_to_one_process(client, tmp_path, tessella
     row = tessellate_split(SCENES / "teapot.bez", tmp_path / "teapot.ply", client=client, parts=7, eps=1e-3,
                            max_factor=256)
     assert row["status"] == "done" and row["parts"] == 7 and row["worker"] == "0,1"
-    expected = single_process_bytes(tessellator, SCENES / "teapot.bez", tmp_path, eps=1e-3, max_factor=256)
+    expected = single_process_bytes(tessellator, SCENES / "teapot.bez", tmp_path, weld=False, eps=1e-3,
+                                    max_factor=256)
     assert (tmp_path / "teapot.ply").read_bytes() == expected
     assert row["output_bytes"] == len(expected)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["single-teapot.bez.ply", "teapot.ply"]
@@ -163,7 +170,7 @@ def test_split_mesh_scene_in_small_batches_is_byte_identical(client, tmp_path, t
     options = BatchOptions(eps=2e-3, max_memory=3 * 200_000)
     row = tessellate_split(scene, tmp_path / "mixed.ply", options, client=client, parts=5)
     assert row["parts"] > 5  # the cap asked for more ranges than 5
-    expected = single_process_bytes(tessellator, scene, tmp_path, eps=2e-3)
+    expected = single_process_bytes(tessellator, scene, tmp_path, weld=False, eps=2e-3)
     assert (tmp_path / "mixed.ply").read_bytes() == expected
 
 
@@ -248,7 +255,7 @@ def test_cli_batch_split_writes_what_tessellate_writes(client, capsys, tmp_path)
                                tmp_path / "out", "--scheduler", client.scheduler.address)
     assert code == 0, stderr
     assert "1 done, 0 up to date, 0 failed" in stdout
-    code, _, stderr = run(capsys, "tessellate", SCENES / "teacup.bez", "--eps", 1e-3, "--no-weld", "--no-orient",
+    code, _, stderr = run(capsys, "tessellate", SCENES / "teacup.bez", "--eps", 1e-3, "--no-weld",
                          "-o", tmp_path / "one.ply", "-q")
     assert code == 0, stderr
     assert (tmp_path / "out" / "teacup.bez.ply").read_bytes() == (tmp_path / "one.ply").read_bytes()
@@ -276,7 +283,9 @@ def test_cli_batch_on_its_own_local_cluster(capsys, inputs, tmp_path):
     (["{teapot}", "--eps", "0.01", "--split", "2", "--format", "obj"], "cannot be split"),
     (["{teapot}", "--eps", "0.01", "--scheduler", "tcp://127.0.0.1:1", "--workers", "2"], "--workers"),
     (["{teapot}", "--eps", "0"], "must be a finite number > 0"),
-    (["{teapot}", "--eps", "0.01", "--split", "2", "--check-bound"], "cannot be used with --split"),
+    (["{teapot}", "--eps", "0.01", "--split", "2", "--check-bound", "--no-weld"], "cannot be used with --split"),
+    (["{teapot}", "--eps", "0.01", "--check-bound"], "add --no-weld"),
+    (["{teapot}", "--eps", "0.01", "--split", "2", "--weld"], "--weld cannot be used with --split"),
     (["{teapot}", "--eps", "0.01", "--pixels", "1"], "not allowed with argument"),
 ])
 def test_cli_batch_bad_arguments_exit_2_before_any_work(capsys, tmp_path, monkeypatch, arguments, fragment):
