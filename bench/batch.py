@@ -53,7 +53,7 @@ def best_of(repeat: int, run) -> tuple[float, object]:
 
 def many_files(args, work: Path) -> dict:
     from cltess.batch import BatchOptions, dask_client, tessellate_files
-    from cltess.formats import load_scene
+    from cltess.io import load_scene
     from cltess.pipeline import Tessellator
     from cltess.stream import tessellate_to_file
 
@@ -94,7 +94,7 @@ def many_files(args, work: Path) -> dict:
 
 def huge_scene(args, work: Path) -> dict:
     from cltess.batch import BatchOptions, dask_client, tessellate_split
-    from cltess.formats import load_scene
+    from cltess.io import load_scene
     from cltess.pipeline import Tessellator
     from cltess.stream import tessellate_to_file
 

@@ -54,7 +54,7 @@ def random_rational_patches(count: int = 20, seed: int = 1) -> np.ndarray:
 
 
 def load_patches(name: str) -> np.ndarray:
-    from cltess.formats import load_scene
+    from cltess.io import load_scene
 
     if name == "random":
         return random_rational_patches()

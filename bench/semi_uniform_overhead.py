@@ -20,7 +20,7 @@ REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 sys.path.insert(0, str(REPO / "tests"))
 
-from cltess.formats import load_scene  # noqa: E402
+from cltess.io import load_scene  # noqa: E402
 from cltess.patterns import semi_uniform as su  # noqa: E402
 from cltess.pipeline import Tessellator  # noqa: E402
 from cltess.scene import Scene  # noqa: E402

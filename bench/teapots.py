@@ -24,7 +24,7 @@ REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 
 from cltess.bench import device_info, machine_info, numpy_evaluate, transform_patches  # noqa: E402
-from cltess.formats import read_bez  # noqa: E402
+from cltess.io import read_bez  # noqa: E402
 from cltess.scene import Scene  # noqa: E402
 
 

@@ -28,7 +28,7 @@ def __getattr__(name):
         from .backends.opencl import Tessellator
         return Tessellator
     if name == "load_scene":
-        from .formats import load_scene
+        from .io import load_scene
         return load_scene
     raise AttributeError(name)
 

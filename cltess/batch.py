@@ -39,7 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from .export import MESH_FORMATS, SUPPORTED_EXTENSIONS, atomic_write, ply_face_records, ply_header, ply_vertex_records
-from .meshes import MESH_EXTENSIONS
+from .io.meshes import MESH_EXTENSIONS
 from .criteria.base import DEFAULT_MAX_FACTOR
 
 MANIFEST_NAME = "manifest.json"
@@ -421,7 +421,7 @@ def _worker_budget(tessellator, options: BatchOptions) -> int:
 
 def _load(path, options: BatchOptions):
     """The scene as ``cltess tessellate`` prepares it: read, then oriented unless told not to."""
-    from .formats import load_scene
+    from .io import load_scene
     from .orient import orient_scene
 
     scene = load_scene(path)

@@ -378,7 +378,7 @@ def _refuse_overwriting_an_input(output: Path, scene: str) -> None:
 def _prepare_scene(args):
     """Load, orient and check the scene; turn a relative --eps into a distance.  Returns (scene,
     orientation report or None, the tolerance as the summary shows it)."""
-    from cltess.formats import load_scene
+    from cltess.io import load_scene
     from cltess.limits import eps_below_float32
 
     scene = load_scene(args.scene, crease_angle=args.crease_angle)

@@ -19,7 +19,7 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
-from cltess.formats import write_bpt  # noqa: E402
+from cltess.io import write_bpt  # noqa: E402
 
 # --------------------------------------------------------------------------- exact sphere
 

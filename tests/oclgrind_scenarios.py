@@ -88,7 +88,7 @@ def bumps(nx: int, ny: int, amplitude) -> np.ndarray:
 
 
 def teapot(indices):
-    from cltess.formats import load_scene
+    from cltess.io import load_scene
     from cltess.scene import Scene
 
     scene = load_scene(SCENES / "teapot.bez")
@@ -168,7 +168,7 @@ def collapsed_bottom_direct():
 
 def rational_sphere():
     """Four patches of the rational sphere (weights != 1, collapsed poles), FD on."""
-    from cltess.formats import load_scene
+    from cltess.io import load_scene
     from cltess.scene import Scene
 
     scene = load_scene(SCENES / "sphere.bpt")

@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from cltess.adjacency import EdgeGroups, edge_groups
-from cltess.formats import load_scene
+from cltess.io import load_scene
 from cltess.scene import boundary_curves
 from support import SCENES, load_make_scenes
 

@@ -18,7 +18,7 @@ import psutil  # noqa: E402 (a dependency of distributed)
 from cltess.batch import (BatchOptions, dask_client, expand_inputs, read_manifest,  # noqa: E402
                           split_ranges, tessellate_files, tessellate_split)
 from cltess.cli import main  # noqa: E402
-from cltess.formats import load_scene  # noqa: E402
+from cltess.io import load_scene  # noqa: E402
 from cltess.orient import orient_scene  # noqa: E402
 from cltess.stream import tessellate_to_file  # noqa: E402
 

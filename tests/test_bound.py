@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from cltess import reference
-from cltess.formats import load_scene
+from cltess.io import load_scene
 from cltess.scene import Camera, Scene
 from conftest import BOUND_RATIOS
 from support import as_float32, bound_ratio, closed_torus_grid, random_patches

@@ -120,7 +120,7 @@ def test_semi_uniform_patch_grid(rng, snapped):
 
 
 def test_sphere_scene_has_no_t_junctions(tessellator):
-    from cltess.formats import load_scene
+    from cltess.io import load_scene
     scene = load_scene(SCENES / "sphere.bpt")
     for eps in (2e-2, 1e-3):  # the sphere gets one factor throughout at 1e-2
         tess = tessellator.tessellate(scene, eps=eps)

@@ -7,7 +7,7 @@ import pytest
 import trimesh
 
 from cltess.cli import main
-from cltess.formats import load_scene
+from cltess.io import load_scene
 from cltess.scene import TriangleMesh, creased_normals, vertex_normals
 
 EPS = 1e-3

@@ -82,7 +82,7 @@ def test_second_derivative_bounds_hold_and_are_tight(rng):
     within 20% of the sampled maximum on the exact sphere and torus (the bound is not slack; the
     torus's quarter-circle patches are the loosest, 13-16%)."""
     from support import SCENES
-    from cltess.formats import load_scene
+    from cltess.io import load_scene
 
     t = np.linspace(0, 1, 41)
     u, v = [x.ravel() for x in np.meshgrid(t, t)]

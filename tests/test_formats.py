@@ -1,4 +1,4 @@
-"""Scene readers and writers (cltess/formats.py) and the generated scenes (scenes/make_scenes.py)."""
+"""Scene readers and writers (cltess/io/) and the generated scenes (scenes/make_scenes.py)."""
 from __future__ import annotations
 
 import json
@@ -11,8 +11,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from cltess import formats
-from cltess.formats import load_scene, write_bez, write_bpt
+from cltess.io import bez, bpt
+from cltess.io import load_scene, write_bez, write_bpt
 from cltess.scene import SceneError
 from support import DATA, SCENES, load_make_scenes
 
@@ -296,7 +296,8 @@ def test_binary_file(tmp_path):
 def test_header_never_allocates(tmp_path, monkeypatch):
     """A huge count is refused from the line count alone, before any array is built."""
     calls = []
-    monkeypatch.setattr(formats, "_floats", lambda *a: calls.append(a))
+    for reader in (bpt, bez):
+        monkeypatch.setattr(reader, "_floats", lambda *a: calls.append(a))
     expect_error(tmp_path, "huge.bpt", "1000000000000\n3 3\n1 2 3\n", "line 1", "truncated")
     expect_error(tmp_path, "huge.bez", "1000000000000\n1,2\n", "line 1", "truncated")
     assert calls == []
@@ -342,8 +343,8 @@ def test_json_transform_ids_and_camera(tmp_path):
 
 def test_json_parses_each_file_once(tmp_path, monkeypatch):
     calls = []
-    original = formats._parse_bez
-    monkeypatch.setattr(formats, "_parse_bez", lambda lines: calls.append(lines.name) or original(lines))
+    original = bez.parse
+    monkeypatch.setattr(bez, "parse", lambda lines: calls.append(lines.name) or original(lines))
     doc = {"objects": [{"file": "teapot.bez"}, {"file": "./teapot.bez"}, {"file": "../" + tmp_path.name + "/teapot.bez"}]}
     scene = load_scene(write_json(tmp_path, doc))
     assert scene.num_patches == 96 and len(calls) == 1

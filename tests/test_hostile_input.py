@@ -391,9 +391,9 @@ def test_json_instancing_beyond_memory_is_refused_before_copying(tmp_path, monke
     """Listing one object a huge number of times must not make the reader allocate it all."""
     import json
 
-    from cltess import formats
+    from cltess.io import json_scene
 
-    monkeypatch.setattr(formats, "_MAX_SCENE_BYTES", 200_000)  # as if the machine had 400 kB
+    monkeypatch.setattr(json_scene, "_MAX_SCENE_BYTES", 200_000)  # as if the machine had 400 kB
     (tmp_path / "teapot.bez").write_bytes((Path(__file__).resolve().parent.parent / "scenes" / "teapot.bez").read_bytes())
     scene = tmp_path / "herd.json"
     scene.write_text(json.dumps({"objects": [{"file": "teapot.bez"}] * 1000}))

@@ -1,4 +1,4 @@
-"""Triangle meshes as PN triangles: reading them (cltess.meshes, formats), their checks and
+"""Triangle meshes as PN triangles: reading them (cltess.io.meshes, cltess.io), their checks and
 repairs (cltess.scene.TriangleMesh), adjacency and sharp edges (cltess.adjacency), scenes
 mixing Bézier patches and meshes, and the command line on a mesh."""
 from __future__ import annotations
@@ -13,7 +13,7 @@ import trimesh
 from cltess import reference
 from cltess.adjacency import mesh_edge_groups, pn_edge_normals
 from cltess.cli import main
-from cltess.formats import load_scene
+from cltess.io import load_scene
 from cltess.pipeline import PN
 from cltess.scene import Scene, SceneError, TriangleMesh, vertex_normals
 from support import flat_shaded, icosphere, split_some_vertices, torus, weld_exact

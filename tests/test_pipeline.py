@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from cltess import reference
-from cltess.formats import load_scene
+from cltess.io import load_scene
 from support import as_float32, closed_torus_grid
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"

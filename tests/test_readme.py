@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 from cltess.cli import main
-from cltess.formats import load_scene
+from cltess.io import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 README = (ROOT / "README.md").read_text()

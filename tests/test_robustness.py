@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 from cltess import limits, reference
 from cltess.cli import build_parser, main, UsageError
 from cltess.device import DEVICE_ENV_VAR
-from cltess.formats import load_scene
+from cltess.io import load_scene
 from cltess.scene import Scene, SceneError
 
 REPO = Path(__file__).resolve().parents[1]

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from cltess import reference
-from cltess.formats import load_scene
+from cltess.io import load_scene
 from cltess.patterns import semi_uniform as su
 from cltess.scene import Scene
 from conftest import BOUND_RATIOS

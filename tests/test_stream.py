@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from cltess.formats import load_scene
+from cltess.io import load_scene
 from cltess.limits import OutputTooLarge
 from cltess.stream import parse_size, tessellate_to_file
 

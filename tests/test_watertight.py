@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cltess.formats import load_scene
+from cltess.io import load_scene
 from cltess.scene import Camera, Scene
 from support import closed_torus_grid, weld_exact
 

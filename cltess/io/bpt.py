@@ -1,0 +1,74 @@
+"""``.bpt`` ("Bézier patch text"): the patch count, then per patch a line ``3 3`` (degrees in u
+and v) and 16 lines ``x y z`` or ``x y z w`` (Cartesian point and weight), rows ``j = 0..3`` of
+four points ``i = 0..3``.  All 16 lines of one patch have the same arity.  ``write_bpt`` uses
+``repr`` floats, so points and weights read back bitwise equal."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..limits import float32_problem
+from ..scene import Scene
+from .text import _cartesian_rows, _floats, _homogeneous, _Lines
+
+_BPT_LINES_PER_PATCH = 17  # "3 3" + 16 points
+
+def read_bpt(path) -> Scene:
+    """A ``.bpt`` file as a single-object scene (object id 0)."""
+    patches = _parse_bpt(_Lines.read(path))
+    return Scene(patches, np.zeros(len(patches), np.int32), None, str(path))
+
+
+def _parse_bpt(lines: _Lines) -> np.ndarray:
+    """``.bpt`` text -> (P, 4, 4, 4) homogeneous patches."""
+    num = lines.count(0, "patch", _BPT_LINES_PER_PATCH, 0)
+    for p in range(num):  # degree lines: "3 3" only (bicubic)
+        k = 1 + p * _BPT_LINES_PER_PATCH
+        tokens = lines.texts[k].split()
+        if tokens != ["3", "3"]:
+            hint = " (a point line: does the previous patch have 16 points?)" if len(tokens) in (3, 4) else ""
+            raise lines.error(
+                k, f"patch {p}: wrong degree {lines.texts[k].strip()[:40]!r}; only bicubic '3 3' is supported{hint}"
+            )
+    point_ks = [1 + p * _BPT_LINES_PER_PATCH + 1 + q for p in range(num) for q in range(16)]
+    rows = [lines.texts[k].split() for k in point_ks]
+    arity = np.array([len(r) for r in rows]).reshape(num, 16)
+    for p in np.flatnonzero((arity != arity[:, :1]).any(axis=1) | ((arity[:, 0] != 3) & (arity[:, 0] != 4))):
+        q = int(np.argmax(arity[p] != arity[p, 0])) if arity[p, 0] in (3, 4) else 0
+        k = point_ks[p * 16 + q]
+        raise lines.error(
+            k,
+            f"patch {p}: expected 'x y z' or 'x y z w' with the same arity on all 16 lines "
+            f"(first line of the patch has {arity[p, 0]} values, this one {arity[p, q]})",
+        )
+    rows = [r if len(r) == 4 else r + ["1"] for r in rows]  # x y z -> weight 1
+    values = _floats(lines, point_ks, rows)
+    weights = values[:, 3]
+    bad = np.flatnonzero(weights <= 0)
+    if len(bad):
+        r = int(bad[0])
+        raise lines.error(point_ks[r], f"patch {r // 16}: weight {float(weights[r])!r} <= 0 (weights must be positive)")
+    lines.no_trailing(1 + num * _BPT_LINES_PER_PATCH, "patch")
+    homogeneous = _homogeneous(values)
+    problem = float32_problem(homogeneous)
+    if problem:
+        r, what = problem
+        raise lines.error(point_ks[r], f"patch {r // 16}: {what}")
+    return homogeneous.reshape(num, 4, 4, 4)
+
+
+def write_bpt(path, patches: np.ndarray) -> None:
+    """Write (P, 4, 4, 4) homogeneous patches as ``.bpt``: ``x y z`` for a patch whose weights
+    are all 1, else ``x y z w``; ``repr`` floats, so reading back gives ``w * (b.xyz / w)``."""
+    patches = np.asarray(patches, dtype=np.float64)
+    out = [f"{len(patches)}"]
+    for patch in _cartesian_rows(patches):
+        rational = not (patch[..., 3] == 1).all()
+        out.append("3 3")
+        for x, y, z, w in patch.reshape(16, 4).tolist():
+            out.append(f"{x!r} {y!r} {z!r} {w!r}" if rational else f"{x!r} {y!r} {z!r}")
+    Path(path).write_text("\n".join(out) + "\n")
+
+
+EXTENSION, parse, read, write = ".bpt", _parse_bpt, read_bpt, write_bpt

@@ -1,0 +1,138 @@
+"""Text helpers shared by the scene readers: lines with their numbers, number tokens checked
+before numpy parses a block, homogeneous patches from Cartesian rows (docs/design.md section 2).
+Every problem is a :class:`~cltess.scene.SceneError` naming the file and the 1-based line."""
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+
+from ..scene import SceneError, check_scene_file
+
+INT32_MAX = 2**31 - 1
+
+# Characters a numeric block may hold; anything else sends the block to the slow
+# line-by-line diagnosis (numpy would accept "1_0", "nan" or non-ASCII digits).
+_FLOAT_BLOCK_BAD = re.compile(r"[^0-9eE.+\-,\s]")
+_INDEX_BLOCK_BAD = re.compile(r"[^0-9+\-,\s]")
+# re.ASCII: \d alone would take any Unicode digit ("\uff11"), which float() and int() accept too.
+_FLOAT_TOKEN = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)
+_NONFINITE_TOKEN = re.compile(r"[+-]?(?:nan|inf|infinity)", re.IGNORECASE | re.ASCII)
+_INT_TOKEN = re.compile(r"[+-]?\d+", re.ASCII)
+
+
+class _Lines:
+    """The non-blank lines of a text file with their 1-based line numbers."""
+
+    def __init__(self, name: str, text: str):
+        self.name = name
+        raw = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")  # lines as editors count them (not at \f, \x1c, ...)
+        self.numbers = [k for k, line in enumerate(raw, 1) if line and not line.isspace()]
+        self.texts = [raw[k - 1] for k in self.numbers]
+
+    @staticmethod
+    def read(path) -> "_Lines":
+        return _Lines(str(path), _read_text(path))
+
+    def __len__(self) -> int:
+        return len(self.texts)
+
+    def error(self, k: int, what: str) -> SceneError:
+        """An error at non-blank line ``k`` (0-based position in ``texts``)."""
+        return SceneError(f"{self.name}: line {self.numbers[k]}: {what}")
+
+    def count(self, k: int, what: str, per_item: int, after: int) -> int:
+        """Parse the count on line ``k``: a positive integer whose ``per_item`` lines each,
+        plus ``after`` more lines, fit in the lines that follow (checked before any allocation)."""
+        tokens = self.texts[k].split()
+        if len(tokens) != 1 or not _INT_TOKEN.fullmatch(tokens[0]):
+            raise self.error(k, f"expected the {what} count (one integer), got {self.texts[k].strip()[:60]!r}")
+        n = _clamped_int(tokens[0])
+        if n <= 0:
+            raise self.error(k, f"{what} count is {n}; need at least one")
+        left = len(self) - k - 1
+        if n > (left - after) // per_item:
+            raise self.error(
+                k,
+                f"{what} count {n} needs {n * per_item + after} more lines but only {left} follow "
+                f"(file truncated, or the count is wrong)",
+            )
+        return n
+
+    def no_trailing(self, k: int, what: str) -> None:
+        if k < len(self):
+            raise self.error(k, f"unexpected content after the last {what}: {self.texts[k].strip()[:60]!r}")
+
+
+def _read_text(path) -> str:
+    check_scene_file(path)
+    try:
+        data = Path(path).read_bytes()
+    except FileNotFoundError:
+        raise SceneError(f"{path}: file not found") from None
+    except OSError as exc:
+        raise SceneError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data[: exc.start].count(b"\n") + 1
+        raise SceneError(f"{path}: line {line}: not UTF-8 text (byte {exc.start})") from None
+    text = text.removeprefix("\ufeff")  # a byte-order mark, as some Windows editors write
+    if not text.strip():
+        raise SceneError(f"{path}: empty file")
+    return text
+
+
+def _clamped_int(token: str) -> int:
+    """An ASCII integer token (``_INT_TOKEN``) as an int clamped to +-2**62, without converting
+    thousands of digits (which Python refuses above sys.get_int_max_str_digits())."""
+    token = token.strip()
+    digits = token.lstrip("+-").lstrip("0")
+    if len(digits) > 18:
+        return -(2**62) if token.startswith("-") else 2**62
+    return int(token)
+
+
+def _token_problem(token: str) -> str | None:
+    """Why ``token`` is not a finite float, or None if it is one."""
+    token = token.strip()
+    if _FLOAT_TOKEN.fullmatch(token):
+        return None if math.isfinite(float(token)) else f"number {token!r} overflows to infinity"
+    if _NONFINITE_TOKEN.fullmatch(token):
+        return f"non-finite value {token!r}"
+    return f"not a number: {token[:40]!r}" if token else "empty value"
+
+
+def _floats(lines: _Lines, ks, rows: list[list[str]]) -> np.ndarray:
+    """Rows of numeric tokens (``rows[r]`` from line position ``ks[r]``, equal lengths) ->
+    finite float64 (R, C).  Fast path: one numpy conversion; on any doubt, find the first bad
+    line for the message."""
+    block = "\n".join(lines.texts[k] for k in ks)
+    if not _FLOAT_BLOCK_BAD.search(block):
+        try:
+            values = np.array(rows, dtype=np.float64)
+        except ValueError:
+            pass
+        else:
+            if np.isfinite(values).all():
+                return values
+    for k, row in zip(ks, rows):
+        for token in row:
+            problem = _token_problem(token)
+            if problem:
+                raise lines.error(k, problem)
+    # every token is an ASCII float numpy did not take (e.g. whitespace it does not strip)
+    return np.array([[float(token) for token in row] for row in rows], dtype=np.float64)
+
+
+def _homogeneous(xyzw: np.ndarray) -> np.ndarray:
+    """(..., 4) Cartesian ``(x, y, z, w)`` -> homogeneous ``(w x, w y, w z, w)`` (docs/design.md section 2)."""
+    return np.concatenate([xyzw[..., :3] * xyzw[..., 3:], xyzw[..., 3:]], axis=-1)
+
+
+def _cartesian_rows(patches: np.ndarray) -> np.ndarray:
+    """(..., 4) homogeneous -> (..., 4) Cartesian ``(x, y, z, w)``, -0.0 written as 0.0."""
+    w = patches[..., 3:]
+    return np.concatenate([patches[..., :3] / w, w], axis=-1) + 0.0
