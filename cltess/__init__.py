@@ -16,7 +16,7 @@ except _metadata.PackageNotFoundError:  # run from a source tree that was never 
 # Before anything lists OpenCL platforms: let the ICD loader see pip-installed CPU runtimes.
 register_pip_runtimes()
 
-from .export import export  # noqa: E402
+from .export import export  # noqa: E402  (the module first: a later import of it cannot hide this function)
 from .request import Request  # noqa: E402
 from .scene import Camera, Scene, SceneError  # noqa: E402
 from .tessellation import Tessellation  # noqa: E402

@@ -6,7 +6,7 @@ device (one GPU per worker where a host has several, ``worker_device``) and one 
 kept for all the tasks it runs.
 
 - :func:`tessellate_files`: one task per input file; each writes its own output (atomically,
-  ``export.atomic_write``) and returns its manifest row.  A bad input fails its own row only.
+  ``io.writing.atomic_write``) and returns its manifest row.  A bad input fails its own row only.
   The manifest (``OUTDIR/manifest.json``) records the options and each input's size, mtime and
   SHA-256, so a rerun skips the inputs whose output is up to date.
 - :func:`tessellate_split`: one scene across the workers.  Stages 1-3 run once, on one worker
@@ -38,7 +38,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .export import MESH_FORMATS, SUPPORTED_EXTENSIONS, atomic_write, ply_face_records, ply_header, ply_vertex_records
+from .io.export import MESH_FORMATS, SUPPORTED_EXTENSIONS
+from .io.ply import ply_face_records, ply_header, ply_vertex_records
+from .io.writing import atomic_write
 from .io.meshes import MESH_EXTENSIONS
 from .criteria.base import DEFAULT_MAX_FACTOR
 
@@ -350,7 +352,8 @@ BOUND_TRIANGLES = 20_000  # --check-bound samples every k-th triangle, about thi
 def read_output(output: Path):
     """The mesh of a .ply (as cltess writes it) or .npz output, for measuring; None for .obj,
     which has no patch ids."""
-    from .export import PLY_FACE_DTYPE, PLY_VERTEX_DTYPE, load_npz
+    from .io.npz import load_npz
+    from .io.ply import PLY_FACE_DTYPE, PLY_VERTEX_DTYPE
     from .tessellation import Tessellation
 
     if output.suffix == ".npz":
@@ -483,7 +486,7 @@ def emit_part_task(planned, index: int, first: int, last: int, parts_dir: str, o
 def join_ply_parts(output, num_vertices: int, num_faces: int, parts_dir, count: int) -> int:
     """Write ``output`` (atomically): the PLY header, vertex parts 0..count-1, face parts
     0..count-1.  Checks each part's length first; returns the file's size."""
-    from .export import PLY_FACE_DTYPE, PLY_VERTEX_DTYPE
+    from .io.ply import PLY_FACE_DTYPE, PLY_VERTEX_DTYPE
 
     folder = Path(parts_dir)
     vertex_parts = [folder / f"vertices-{i:06d}.bin" for i in range(count)]

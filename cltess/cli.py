@@ -29,7 +29,7 @@ import threading
 import warnings
 from pathlib import Path
 
-from cltess.export import MESH_FORMATS, SUPPORTED_EXTENSIONS, check_extension
+from cltess.io.export import MESH_FORMATS, SUPPORTED_EXTENSIONS, check_extension
 from cltess.scene import DEFAULT_CREASE_ANGLE
 
 PROG = "cltess"
@@ -438,7 +438,7 @@ def _progress(args, what: str):
 def cmd_tessellate(args) -> int:
     """Load, tessellate, export, summarise."""
     from cltess.device import pick_device
-    from cltess.export import estimate_output_bytes, estimate_write_seconds
+    from cltess.io.export import estimate_output_bytes, estimate_write_seconds
     from cltess.limits import OutputTooLarge
     from cltess.stream import tessellate_to_file
 

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .export import atomic_write
+from .io.writing import atomic_write
 
 __all__ = ["Rasteriser", "View", "factor_colours", "render", "view_for", "write_png"]
 

@@ -4,7 +4,7 @@ Stages 1-3 run once for the whole scene (``Tessellator.plan``): the scan tells t
 before anything big is allocated.  The patches are then cut into consecutive batches whose
 output fits the budget; each batch runs stages 4-5 (``Tessellator.emit``) and is appended to a
 streaming PLY or OBJ writer.  The file is the same, byte for byte, as a single pass would
-write, and it appears only when complete (``export.atomic_write``).
+write, and it appears only when complete (``io.writing.atomic_write``).
 
 Memory: a batch's output lives three times at once at most (the device buffers, their host
 copy, the writer's records), so batches are sized to a third of the budget; on a CPU device the
@@ -18,7 +18,9 @@ from pathlib import Path
 import pyopencl as cl
 
 from .limits import OutputTooLarge
-from .export import ObjWriter, PlyWriter, check_extension, export
+from .io.export import check_extension, export
+from .io.obj import ObjWriter
+from .io.ply import PlyWriter
 
 COPIES_IN_FLIGHT = 3  # device buffers, host copy, writer records
 STREAMING_WRITERS = {".ply": PlyWriter, ".obj": ObjWriter}

@@ -65,6 +65,6 @@ class Tessellation:
     def to_trimesh(self, weld: bool = True):
         """A ``trimesh.Trimesh``: welded (watertight where the surface is closed) by default, else
         the per-patch vertices as they are."""
-        from .export import to_trimesh
+        from .io.trimesh_formats import to_trimesh
 
         return to_trimesh(self.welded(check_t_junctions=False) if weld else self)

@@ -329,7 +329,7 @@ def _fill_by_copy():
 
 
 def run_scenario(name: str, tessellator, out_dir: Path) -> dict:
-    from cltess.export import write_npz
+    from cltess.io.npz import write_npz
     from cltess.tessellation import Tessellation
 
     if name in BATCHED:

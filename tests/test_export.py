@@ -12,20 +12,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
-from cltess.export import (
-    PLY_FACE_DTYPE,
-    PLY_VERTEX_DTYPE,
-    ObjWriter,
-    PlyWriter,
-    VertexBlock,
-    atomic_write,
-    check_extension,
-    export,
-    load_npz,
-)
+from cltess.io.export import check_extension, export
+from cltess.io.npz import load_npz
+from cltess.io.obj import ObjWriter
+from cltess.io.ply import PLY_FACE_DTYPE, PLY_VERTEX_DTYPE, PlyWriter
+from cltess.io.writing import VertexBlock, atomic_write
 from cltess.tessellation import Tessellation
 
-export_module = importlib.import_module("cltess.export")  # the module, whatever cltess.export is bound to
+export_module = importlib.import_module("cltess.io.writing")  # where atomic_write lives
 
 
 def grid_tessellation(nu: int = 5, nv: int = 4, seed: int = 0) -> Tessellation:

@@ -364,7 +364,8 @@ def test_kernel_build_failure_shows_the_build_log(capsys, tmp_path, monkeypatch)
 def test_ctrl_c_mid_write_leaves_no_partial_file(capsys, tmp_path, monkeypatch, extension):
     """KeyboardInterrupt after some batches were already written (a small --max-memory cap
     makes many batches): exit 130, the earlier file intact, no temporary file left."""
-    from cltess.export import ObjWriter, PlyWriter
+    from cltess.io.obj import ObjWriter
+    from cltess.io.ply import PlyWriter
 
     writer = PlyWriter if extension == ".ply" else ObjWriter
     calls = []

@@ -32,7 +32,7 @@ import pytest
 
 import oclgrind_scenarios as scenarios
 from cltess.device import list_devices
-from cltess.export import load_npz
+from cltess.io.npz import load_npz
 
 HERE = Path(__file__).resolve().parent
 NAMES = [*scenarios.SCENARIOS, *scenarios.BATCHED]

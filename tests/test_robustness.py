@@ -460,7 +460,7 @@ def test_a_patch_collapsed_to_a_point_gets_factors_1_and_no_warning(capsys, tmp_
     out = tmp_path / "m.npz"
     code, err = run_cli(capsys, "tessellate", scene, "--eps", "0.001", "--max-factor", "64", "-o", out)
     assert code == 0 and "does not meet" not in err, err  # (at 1e5, eps is flagged as below float32's steps)
-    from cltess.export import load_npz
+    from cltess.io.npz import load_npz
 
     tess = load_npz(out)
     assert tess.factors[1].tolist() == [1, 1, 1, 1]

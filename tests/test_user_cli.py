@@ -12,7 +12,7 @@ import trimesh
 
 import cltess
 from cltess.cli import main
-from cltess.export import estimate_output_bytes
+from cltess.io.export import estimate_output_bytes
 from cltess.io import load_scene
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"

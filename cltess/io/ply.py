@@ -1,0 +1,115 @@
+"""Binary little-endian PLY: per-patch output streamed in blocks (``PlyWriter``; vertex
+``float x y z nx ny nz u v``, ``int patch object``; face ``list uchar uint vertex_indices``) and
+one welded mesh (``write_welded_ply``)."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..tessellation import VERTEX_RECORD, Tessellation
+from .writing import _StreamingWriter, _vertex_arrays, atomic_write
+
+#: The PLY property names of each field of the vertex record (cltess.tessellation.VERTEX_RECORD).
+PLY_COLUMNS = {"positions": ("x", "y", "z"), "normals": ("nx", "ny", "nz"), "uv": ("u", "v"),
+               "patch_ids": ("patch",), "object_ids": ("object",)}
+#: One PLY vertex record, the vertex record little-endian: 8 float32 then 2 int32 (40 bytes).
+PLY_VERTEX_DTYPE = np.dtype([(column, np.dtype(dtype).newbyteorder("<"))
+                             for name, dtype, _ in VERTEX_RECORD for column in PLY_COLUMNS[name]])
+_PLY_TYPES = {"f4": "float", "i4": "int"}
+#: One PLY face record: ``list uchar uint`` with a constant count of 3 (13 bytes, no padding).
+PLY_FACE_DTYPE = np.dtype([("count", "u1"), ("vertex_indices", "<u4", (3,))])
+
+
+def ply_header(num_vertices: int, num_faces: int) -> bytes:
+    """The header of a cltess PLY file with these totals."""
+    lines = [
+        "ply",
+        "format binary_little_endian 1.0",
+        "comment written by cltess",
+        f"element vertex {num_vertices}",
+        *(f"property {_PLY_TYPES[PLY_VERTEX_DTYPE[name].str[1:]]} {name}" for name in PLY_VERTEX_DTYPE.names),
+        f"element face {num_faces}",
+        "property list uchar uint vertex_indices",
+        "end_header",
+    ]
+    return ("\n".join(lines) + "\n").encode("ascii")
+
+
+def ply_vertex_records(block) -> np.ndarray:
+    """The PLY vertex records (PLY_VERTEX_DTYPE) of a block with positions, normals, uv,
+    patch_ids, object_ids."""
+    arrays = _vertex_arrays(block)
+    records = np.empty(len(arrays.positions), PLY_VERTEX_DTYPE)
+    for name, _, shape in VERTEX_RECORD:
+        values = getattr(arrays, name)
+        for k, column in enumerate(PLY_COLUMNS[name]):
+            records[column] = values[:, k] if shape else values
+    return records
+
+
+def ply_face_records(triangles) -> np.ndarray:
+    """The PLY face records (PLY_FACE_DTYPE) of (k, 3) vertex indices."""
+    faces = np.ascontiguousarray(triangles, dtype=np.uint32)
+    records = np.empty(len(faces), PLY_FACE_DTYPE)
+    records["count"] = 3
+    records["vertex_indices"] = faces
+    return records
+
+
+class PlyWriter(_StreamingWriter):
+    """Binary little-endian PLY, written in blocks.
+
+    Vertex element: ``float x y z nx ny nz u v``, ``int patch object``.
+    Face element: ``list uchar uint vertex_indices``.
+    Face blocks that arrive before the last vertex block are spooled to an anonymous
+    temporary file and appended after the vertices when the writer closes.
+    """
+
+    def header(self) -> bytes:
+        return ply_header(self.num_vertices, self.num_faces)
+
+    def _write_header(self) -> None:
+        self._file.write(self.header())
+
+    def write_vertices(self, block) -> None:
+        """Append vertices: ``block`` has positions (k,3), normals (k,3), uv (k,2), patch_ids, object_ids (k,)."""
+        self._file.write(ply_vertex_records(self._take_vertices(block)).view(np.uint8))
+
+    def write_faces(self, triangles) -> None:
+        """Append faces: (k, 3) global, 0-based vertex indices."""
+        self._put_faces(ply_face_records(self._take_faces(triangles)).tobytes())
+
+
+def write_ply(tess: Tessellation, path) -> None:
+    with PlyWriter(path, tess.num_vertices, tess.num_triangles) as writer:
+        writer.write_vertices(tess)
+        writer.write_faces(tess.triangles)
+
+
+def write_welded_ply(mesh, path) -> None:
+    """Binary PLY of a WeldedMesh: vertex ``float x y z nx ny nz``, ``int object``; face
+    ``list uchar uint vertex_indices``, ``int patch`` and, with a uv seam, ``list uchar float
+    texcoord`` (u0 v0 u1 v1 u2 v2: per-wedge texture coordinates, as MeshLab reads them)."""
+    vertex = np.dtype([*((name, "<f4") for name in ("x", "y", "z", "nx", "ny", "nz")), ("object", "<i4")])
+    fields = [("count", "u1"), ("vertex_indices", "<u4", (3,)), ("patch", "<i4")]
+    if mesh.corner_uv is not None:
+        fields += [("uv_count", "u1"), ("texcoord", "<f4", (6,))]
+    face = np.dtype(fields)
+    header = ["ply", "format binary_little_endian 1.0", "comment written by cltess (welded)",
+              f"element vertex {mesh.num_vertices}",
+              *(f"property float {name}" for name in ("x", "y", "z", "nx", "ny", "nz")), "property int object",
+              f"element face {mesh.num_triangles}", "property list uchar uint vertex_indices", "property int patch"]
+    if mesh.corner_uv is not None:
+        header.append("property list uchar float texcoord")
+    vertices = np.empty(mesh.num_vertices, vertex)
+    for column, name in enumerate(("x", "y", "z")):
+        vertices[name] = mesh.positions[:, column]
+        vertices["n" + name] = mesh.normals[:, column]
+    vertices["object"] = mesh.object_ids
+    faces = np.empty(mesh.num_triangles, face)
+    faces["count"], faces["vertex_indices"], faces["patch"] = 3, mesh.triangles, mesh.patch_ids
+    if mesh.corner_uv is not None:
+        faces["uv_count"], faces["texcoord"] = 6, mesh.corner_uv.reshape(-1, 6)
+    with atomic_write(path, "wb") as handle:
+        handle.write(("\n".join(header) + "\nend_header\n").encode("ascii"))
+        handle.write(vertices.tobytes())
+        handle.write(faces.tobytes())
