@@ -32,6 +32,7 @@ from ...limits import OutputTooLarge, check_totals
 from ...kinds import BEZIER, FACTOR_SLOTS, FLAG_CULLED, FLAG_SATURATED, KINDS, PN, PatchKind
 from ...kinds import kind as kind_named
 from ...patterns import PATTERNS, Pattern
+from ...patterns.semi_uniform import DEFAULT_MAX_LEVEL
 from ...request import Request
 from ...scene import Scene
 from ...tessellation import BYTES_PER_INDEX, BYTES_PER_VERTEX, VERTEX_RECORD, Tessellation
@@ -132,7 +133,7 @@ class Tessellator:
         events = {"factors": []}
         for part in parts:
             events["factors"] += self.stage_factors_of(part.kind, part.data, tolerance, request.max_factor,
-                                                       factors, flags, part.base)
+                                                       factors, flags, part.base, part.pattern, request.max_level)
         groups = scene.prepared(("edge groups", sharp_edges), lambda: merge_edge_groups(
             [(host.groups, part.kind.edges, part.base) for host, part in zip(inputs, parts)], count, FACTOR_SLOTS))
         final, events["crack_free"] = self.stage_crack_free(factors, groups)
@@ -241,13 +242,17 @@ class Tessellator:
                                        _tolerance(eps, pixels, camera), max_factor, factors, flags)
         return controls, factors, flags, events
 
-    def stage_factors_of(self, kind, data, tolerance, max_factor, factors, flags, patch_base=0):
+    def stage_factors_of(self, kind, data, tolerance, max_factor, factors, flags, patch_base=0, pattern=None,
+                         max_level=DEFAULT_MAX_LEVEL):
         """Stage 1 for a kind: data its device arrays (``upload``), tolerance an ObjectSpace or
-        ScreenSpace; writes factors and flags of its patches at patch_base.., and returns the events."""
+        ScreenSpace; writes factors and flags of its patches at patch_base.., and returns the events.
+        pattern: the kind's own unless given; a dyadic one rounds the factors to 2^p_e,
+        p_e <= max_level."""
         count = len(data["source"])
-        event = self.programs.kernel("factors", kind=kind, tolerance=tolerance)(
+        event = self.programs.kernel("factors", kind=kind, tolerance=tolerance, pattern=pattern or kind.pattern)(
             self.queue, _global_size(count), None, data["source"].data, data["controls"].data, np.uint32(count),
-            np.uint32(patch_base), *tolerance.kernel_args(), np.int32(max_factor), factors.data, flags.data)
+            np.uint32(patch_base), *tolerance.kernel_args(), np.int32(max_factor), np.int32(max_level),
+            factors.data, flags.data)
         return [event]
 
     def stage_crack_free(self, factors, groups):
