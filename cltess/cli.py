@@ -2,7 +2,8 @@
 
     cltess devices [--verbose]
     cltess tessellate SCENE (--eps E | --pixels PX) [--no-fd] [--max-factor N] [--max-memory SIZE]
-                      [--sharp-edges {straight,average,keep}] [--device NAME] [--quiet] -o OUT
+                      [--sharp-edges {straight,average,keep}] [--pattern {transition,semi-uniform}]
+                      [--max-level L] [--check-t-junctions] [--device NAME] [--quiet] -o OUT
     cltess bench [SCENES...] [--device NAME] [--repeat N] [--warmup N] [--no-baseline] [--json OUT]
     cltess batch INPUTS... (--eps E | --pixels PX) -o OUTDIR [--format {ply,obj,npz}] [--split N]
                  [--scheduler ADDRESS] [--workers N] [tessellate's options]
@@ -79,6 +80,22 @@ def _max_factor(text: str) -> int:
         raise argparse.ArgumentTypeError(str(error).removeprefix("max_factor ")) from None
 
 
+#: --pattern's choices: the pattern families (cltess.patterns.FAMILIES), as the command line spells them.
+PATTERN_CHOICES = {"transition": "transition", "semi-uniform": "semi_uniform"}
+
+
+def _max_level(text: str) -> int:
+    from cltess.request import MAX_LEVEL
+
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
+    if not 0 <= value <= MAX_LEVEL:
+        raise argparse.ArgumentTypeError(f"must be in 0..{MAX_LEVEL}, got {value}")
+    return value
+
+
 def _memory_size(text: str) -> int:
     from cltess.stream import parse_size
 
@@ -144,6 +161,16 @@ def build_parser() -> argparse.ArgumentParser:
                      help="meshes: an edge whose two sides have different vertex normals becomes a "
                           "straight crease (default), a curve from the averaged normals, or keeps "
                           "each side's own PN curve (may crack)")
+    run.add_argument("--pattern", choices=tuple(PATTERN_CHOICES), default="transition",
+                     help="tessellation pattern of every patch: transition strips between edge factors "
+                          "(default), or semi-uniform (Dyken et al. 2009: a uniform 2^m grid per patch, "
+                          "edges snapped to their own dyadic level; factors rounded up to powers of two)")
+    run.add_argument("--max-level", type=_max_level, default=6, metavar="L",
+                     help="semi-uniform: the largest level (edge factor 2^L; default 6); a patch that "
+                          "needs more is saturated")
+    run.add_argument("--check-t-junctions", action="store_true",
+                     help="read the output back (.ply, .npz) and count its T-junctions after exact "
+                          "welding (cltess.checks; slow on large meshes)")
     run.add_argument("-o", "--output", required=True, metavar="OUT",
                      help=f"output mesh: {', '.join(SUPPORTED_EXTENSIONS)}")
     run.add_argument("-q", "--quiet", action="store_true", help="print nothing on success (warnings still go to stderr)")
@@ -272,16 +299,22 @@ def cmd_tessellate(args) -> int:
     mesh_options = {"sharp_edges": args.sharp_edges} if scene.meshes else {}
     result = tessellate_to_file(tessellator, scene, output, max_memory_bytes=args.max_memory, eps=args.eps,
                                 pixels=args.pixels, max_factor=args.max_factor,
-                                forward_differencing=not args.no_fd, **mesh_options)
+                                forward_differencing=not args.no_fd, pattern=PATTERN_CHOICES[args.pattern],
+                                max_level=args.max_level, **mesh_options)
     if result.batches > 1:
         result.stats["batches"] = result.batches
+    if args.check_t_junctions:
+        result.stats["t_junctions"] = _count_t_junctions(output)
 
     saturated = int(result.stats.get("saturated", 0))
     if saturated:
         patches = "1 patch reaches" if saturated == 1 else f"{saturated} patches reach"
         verb = "does" if saturated == 1 else "do"
-        print(f"{PROG}: warning: {patches} --max-factor {args.max_factor} and {verb} not meet the error "
-              "bound; raise --max-factor", file=sys.stderr)
+        cap = f"--max-factor {args.max_factor}" if args.pattern == "transition" else \
+            f"--max-factor {args.max_factor} or 2^--max-level {args.max_level}"
+        raise_it = "--max-factor" if args.pattern == "transition" else "them"
+        print(f"{PROG}: warning: {patches} {cap} and {verb} not meet the error "
+              f"bound; raise {raise_it}", file=sys.stderr)
     if not int(result.stats.get("triangles", 0)):
         reasons = [f"{result.stats[key]} {label}" for key, label in
                    (("culled", "outside the camera's view"), ("folded_triangles", "folded mesh triangles"))
@@ -300,8 +333,20 @@ def cmd_tessellate(args) -> int:
     return EXIT_OK
 
 
+def _count_t_junctions(output: Path) -> int | str:
+    """T-junctions of the written mesh (cltess.checks.t_junctions, per object), or why not."""
+    from cltess.batch import read_output
+    from cltess.checks import t_junctions
+
+    mesh = read_output(output)
+    if mesh is None:
+        return f"not checked ({output.suffix} is not read back; write .ply or .npz)"
+    return len(t_junctions(mesh.positions, mesh.triangles, mesh.object_ids))
+
+
 def format_summary(stats: dict, stage_ms: dict, scene, device: str, tolerance: str, output) -> str:
-    """The tessellate summary: counts, extra int stats, per-stage ms, output path."""
+    """The tessellate summary: counts, extra int stats, the semi-uniform level histogram, the
+    T-junction count when checked, per-stage ms, output path."""
     rows = [
         ("scene", f"{scene}  ({tolerance}, device {device})"),
         ("patches", f"{stats.get('patches', '?')}  (culled {stats.get('culled', '?')}, "
@@ -312,6 +357,11 @@ def format_summary(stats: dict, stage_ms: dict, scene, device: str, tolerance: s
     for name, value in stats.items():
         if name not in _MAIN_STATS and isinstance(value, int) and not isinstance(value, bool):
             rows.append((name.replace("_", " "), value))
+    if stats.get("patch_levels"):
+        rows.append(("patch levels", ", ".join(f"{level}: {count}" for level, count in
+                                               enumerate(stats["patch_levels"]) if count)))
+    if isinstance(stats.get("t_junctions"), str):
+        rows.append(("t junctions", stats["t_junctions"]))
     if stage_ms:
         rows.append(("stage ms", ", ".join(f"{name} {ms:.3f}" for name, ms in stage_ms.items())))
     rows.append(("wrote", output))

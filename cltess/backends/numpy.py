@@ -13,7 +13,7 @@ from ..crack.adjacency import crack_free_factors, merge_edge_groups
 from ..kinds import FACTOR_SLOTS, FLAG_CULLED, FLAG_SATURATED, KINDS
 from ..kinds import kind as kind_named
 from ..patterns import quad_pattern, tri_pattern
-from ..patterns.semi_uniform import dyadic_factors
+from ..patterns.semi_uniform import dyadic_factors, level_histogram
 from ..request import Request
 from ..scene import Scene
 from ..surfaces.bezier import evaluate
@@ -135,6 +135,9 @@ class NumpyBackend:
             vertex_counts[b:b + count], index_counts[b:b + count] = pattern.counts(final[b:b + count])
         stats = {"patches": base, "culled": int(np.count_nonzero(flags & FLAG_CULLED)),
                  "saturated": int(np.count_nonzero(flags & FLAG_SATURATED))}
+        if any(pattern.dyadic for _, pattern, _, _, _ in parts):
+            stats["patch_levels"] = level_histogram(np.concatenate(
+                [final[b:b + count] for _, pattern, b, count, _ in parts if pattern.dyadic]))
         return NumpyPlan(scene.name, base, parts, np.concatenate([h.objects for h in inputs]), final,
                          offsets(vertex_counts), offsets(index_counts), stats)
 

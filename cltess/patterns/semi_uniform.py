@@ -73,6 +73,14 @@ def dyadic_factors(factors, max_level: int = DEFAULT_MAX_LEVEL) -> np.ndarray:
     return np.where(levels >= 0, np.left_shift(1, np.maximum(levels, 0)), 0).astype(np.int32)
 
 
+def level_histogram(records) -> list[int]:
+    """Patches per level m = log2 max_e f_e of records of dyadic factors (P, 4), culled ones
+    left out: [patches at level 0, level 1, ...] up to the highest level present."""
+    records = np.asarray(records, np.int64).reshape(-1, 4)
+    sizes = records[records[:, 0] > 0].max(axis=1)
+    return np.bincount(ceil_log2(sizes)).tolist() if len(sizes) else []
+
+
 def record_levels(record, domain: str) -> tuple[int, list[int]]:
     """(m, [p_e]) of one record of dyadic factors; m = -1 when culled."""
     f = [int(x) for x in record[:EDGES[domain]]]
@@ -230,6 +238,6 @@ def counts(records, domain: str) -> tuple[np.ndarray, np.ndarray]:
     return out[0], out[1]
 
 
-__all__ = ["DEFAULT_MAX_LEVEL", "EDGES", "ceil_log2", "edge_levels", "dyadic_factors", "record_levels", "snap",
+__all__ = ["DEFAULT_MAX_LEVEL", "EDGES", "ceil_log2", "edge_levels", "dyadic_factors", "level_histogram", "record_levels", "snap",
            "edge_point", "edge_parameter", "phi", "uniform_triangles", "lattice_layout", "vertex_count",
            "triangle_count", "pattern", "quad_pattern", "tri_pattern", "counts", "QUAD_SEMI_UNIFORM", "TRI_SEMI_UNIFORM"]

@@ -32,7 +32,7 @@ from ...limits import OutputTooLarge, check_totals
 from ...kinds import BEZIER, FACTOR_SLOTS, FLAG_CULLED, FLAG_SATURATED, KINDS, PN, PatchKind
 from ...kinds import kind as kind_named
 from ...patterns import PATTERNS, Pattern
-from ...patterns.semi_uniform import DEFAULT_MAX_LEVEL
+from ...patterns.semi_uniform import DEFAULT_MAX_LEVEL, level_histogram
 from ...request import Request
 from ...scene import Scene
 from ...tessellation import BYTES_PER_INDEX, BYTES_PER_VERTEX, VERTEX_RECORD, Tessellation
@@ -155,8 +155,13 @@ class Tessellator:
         }
         for host in inputs:
             stats.update(host.stats)
+        read_back = {}
+        if any(part.pattern.dyadic for part in parts):  # the semi-uniform patches' levels
+            read_back["factors"] = final.get()
+            stats["patch_levels"] = level_histogram(np.concatenate(
+                [read_back["factors"][p.base:p.base + p.count] for p in parts if p.pattern.dyadic]))
         return Plan(scene.name, count, parts, objects, final, vertex_offsets, index_offsets,
-                    num_vertices, num_indices, stats, events, started, request)
+                    num_vertices, num_indices, stats, events, started, request, _host=read_back)
 
     def upload(self, kind: PatchKind, source: np.ndarray) -> dict:
         """Device arrays of a kind: "source" (one row per patch) for stage 1, "controls" what
