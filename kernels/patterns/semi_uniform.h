@@ -139,4 +139,60 @@ inline uint pattern_primitives(int4 f, __global uint *out, uint base)
     return count;
 }
 
+/* --- the template: P^m's lattice points, for evaluation by level ------------------------------ */
+
+/* The paper's section 4.2 draws each level's patches as instances of one template, P^m's
+ * vertices; stages/level_vertices.cl runs one work-item per (patch of level m, template point).
+ * Template point t is lattice point (i, j), row by row: (n+1)^2 (quad) or (n+1)(n+2)/2
+ * (triangle) of them. */
+inline int pattern_template_size(int level)
+{
+    int n = 1 << level;
+    return PATTERN_EDGES == 4 ? (n + 1) * (n + 1) : (n + 1) * (n + 2) / 2;
+}
+
+/* Where template point t of a patch with record f (n = 2^level = su_size(f)) goes in the vertex
+ * layout: vertex < 0 when the snap removes it (a boundary point of an edge below the level);
+ * else its local vertex number, and either the ring point k of edge e (edge >= 0; each edge owns
+ * its points a = 0 .. n-1, the end being the next edge's point 0, as stages/vertices.cl writes
+ * them), or the interior point (i, j) (edge = -1, at pattern_row_point(f, j, i)). */
+typedef struct {
+    int vertex;
+    int edge;
+    int k;
+    int i;
+    int j;
+} template_point;
+
+inline template_point pattern_template_point(int4 f, int level, int t)
+{
+    int n = 1 << level, i, j = 0, e = -1, a = 0;
+#if PATTERN_EDGES == 4
+    i = t % (n + 1);
+    j = t / (n + 1);
+    if (j == 0 && i < n) { e = 0; a = i; }
+    else if (i == n && j < n) { e = 1; a = j; }
+    else if (j == n && i > 0) { e = 2; a = n - i; }
+    else if (i == 0 && j > 0) { e = 3; a = n - j; }
+    int interior = (int)(f.s0 + f.s1 + f.s2 + f.s3) + (j - 1) * (n - 1) + (i - 1);
+#else
+    while (t > n - j) {  /* row j has n + 1 - j points */
+        t -= n + 1 - j;
+        ++j;
+    }
+    i = t;
+    if (i + j == n && j < n) { e = 0; a = j; }
+    else if (i == 0 && j > 0) { e = 1; a = n - j; }
+    else if (j == 0 && i < n) { e = 2; a = i; }
+    int interior = (int)(f.s0 + f.s1 + f.s2) + (j - 1) * (2 * n - 2 - j) / 2 + (i - 1);
+#endif
+    template_point point = {interior, e, 0, i, j};
+    if (e >= 0) {
+        int d = n / factor_of(f, e);  /* the edge's own points: multiples of d */
+        point.k = a / d;
+        point.vertex = a % d ? -1 : (int)ring_index(f, e, a / d);
+    }
+    return point;
+}
+
 #endif

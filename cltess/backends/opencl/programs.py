@@ -26,6 +26,8 @@ STAGE_AXES = {
     "counts": ("pattern",),
     "vertices": ("kind", "pattern"),
     "indices": ("pattern",),
+    # stage 4 by level (levels.py), for a pattern with a template: built when it is asked for
+    "level_vertices": ("kind", "pattern"),
 }
 
 
