@@ -297,6 +297,10 @@ SCENARIOS = {
 #: output cap in bytes, so stages 4-5 run on sub-ranges of the patches.
 BATCHED = {"many_patches_batched": ("many_patches", 4096)}
 
+#: Scenarios whose stage 4 runs by level (cltess/backends/opencl/levels.py emit_by_level).
+BY_LEVEL = {"semi_uniform_by_level": "semi_uniform",
+            "pn_semi_uniform_mixed_culled_by_level": "pn_semi_uniform_mixed_culled"}
+
 
 # --------------------------------------------------------------------------- self-tests
 
@@ -369,6 +373,12 @@ def run_scenario(name: str, tessellator, out_dir: Path) -> dict:
                                for k in ("positions", "normals", "uv", "patch_ids", "object_ids",
                                          "triangles", "factors")},
                             stats=dict(parts[0].stats, batches=len(parts)))
+    elif name in BY_LEVEL:
+        from cltess.backends.opencl.levels import emit_by_level, plan_by_level
+        from cltess.request import Request
+
+        scene, options = SCENARIOS[BY_LEVEL[name]]()
+        tess = emit_by_level(tessellator, plan_by_level(tessellator, scene, Request.of(**options)))
     else:
         scene, options = SCENARIOS[name]()
         tess = tessellator.tessellate(scene, **options)

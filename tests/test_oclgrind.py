@@ -35,7 +35,7 @@ from cltess.device import list_devices
 from cltess.export import load_npz
 
 HERE = Path(__file__).resolve().parent
-NAMES = [*scenarios.SCENARIOS, *scenarios.BATCHED]
+NAMES = [*scenarios.SCENARIOS, *scenarios.BATCHED, *scenarios.BY_LEVEL]
 
 PASSES = {
     "checks": dict(env=scenarios.OCLGRIND_ENV, args=[],

@@ -1,10 +1,10 @@
 /* Stage 4 by level, for a pattern with a template (the semi-uniform one: patterns/semi_uniform.h
  * pattern_template_point): the paper's per-level instanced draws (Dyken et al. 2009, section
  * 4.2) as one launch per level over (queue slot, template point).  queue: the scene numbers of
- * the patches of level `level` (cltess/backends/opencl/levels.py partitions them by level with
- * pyopencl.algorithm.copy_if).  Each vertex goes where stages/vertices.cl puts it and is computed
- * as it computes it with direct evaluation (kind_boundary_point on the ring, kind_eval inside),
- * so the output is bitwise that of the patch-parallel stage 4 without forward differencing. */
+ * the patches of level `level` (cltess/backends/opencl/levels.py level_scan, one stream
+ * compaction per level).  Each vertex goes where stages/vertices.cl puts it and is computed as
+ * it computes it with direct evaluation (kind_boundary_point on the ring, kind_eval inside), so
+ * the output is bitwise that of the patch-parallel stage 4 without forward differencing. */
 __kernel void level_vertices(__global const float4 *controls, __global const int4 *factors,
                              __global const ulong *vertex_offsets, __global const int *patch_objects,
                              __global const uint *queue, uint queue_size, int level, uint patch_base,

@@ -1,8 +1,8 @@
 """Stage 4 by level, beside the patch-parallel stage 4 (Dyken, Reimers and Seland 2009, section
 4.2; docs/design.md section 5): the patches of a pattern with a template (the semi-uniform ones)
-are partitioned by their level m on the device, one ``pyopencl.algorithm.copy_if`` per level
-(the paper's CUDA remark: one stream compaction per bucket; its counts are the histogram of
-levels, the only read-back), and each level's queue is evaluated by one launch of
+are partitioned by their level m on the device, one stream compaction per level (the paper's
+CUDA remark; pyopencl.algorithm.copy_if's scan, ``level_scan``), whose counts are the histogram
+of levels (the only read-back), and each level's queue is evaluated by one launch of
 ``stages/level_vertices.cl`` over (queue slot, template point of P^m), the paper's instanced
 draw of the level's template.  Other patterns keep the patch-parallel stage 4; stage 5 is the
 patch-parallel one for all.
@@ -15,9 +15,10 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-import pyopencl.algorithm as cl_algorithm
 import pyopencl.array as cl_array
+from pyopencl.scan import GenericScanKernel
 
+from ...kinds import KINDS
 from ...tessellation import Tessellation
 from .tessellator import WORK_GROUP, Plan, Tessellator, _span_ms
 
@@ -30,6 +31,21 @@ inline int patch_level(__global const int *factors, uint p)
 }
 """
 
+_LEVEL_SCANS: dict = {}
+
+
+def level_scan(context) -> GenericScanKernel:
+    """Stream compaction of the patches ``base .. base + N - 1`` of level ``level`` into ``queue``
+    (patch order kept), their number into ``count[0]``: pyopencl.algorithm.copy_if's scan, over
+    patch numbers instead of an input array, built once per context."""
+    if context not in _LEVEL_SCANS:
+        _LEVEL_SCANS[context] = GenericScanKernel(
+            context, np.uint32, preamble=LEVEL_PREAMBLE,
+            arguments="__global const int *factors, uint base, int level, __global uint *queue, __global uint *count",
+            input_expr="patch_level(factors, base + i) == level ? 1 : 0", scan_expr="a+b", neutral="0",
+            output_statement="if (prev_item != item) queue[prev_item] = base + i; if (i + 1 == N) count[0] = item;")
+    return _LEVEL_SCANS[context]
+
 
 @dataclass
 class LevelQueue:
@@ -40,17 +56,32 @@ class LevelQueue:
     count: int
 
 
+def plan_by_level(tessellator: Tessellator, scene, request) -> Plan:
+    """``tessellator.plan`` with every program the level path needs built first, as the plan
+    builds its own (a build after the plan's buffers exist makes Oclgrind's uninitialised-value
+    plugin report the scans' output, tests/test_oclgrind.py)."""
+    tolerance = request.tolerance_for(scene)
+    for kind in (kind for kind in KINDS if kind.count(scene)):
+        pattern = request.pattern_for(kind)
+        tessellator.programs.compose(kind, pattern, tolerance)
+        if pattern.dyadic:
+            tessellator.programs.kernel("level_vertices", kind=kind, pattern=pattern)
+    level_scan(tessellator.context)
+    return tessellator.plan(scene, request)
+
+
 def level_queues(tessellator: Tessellator, plan: Plan, part, max_level: int) -> tuple[list[LevelQueue], list]:
     """The part's patches partitioned by level 0 .. max_level on the device (patch order kept
-    within a level), and the events."""
-    patches = cl_array.arange(tessellator.queue, part.base, part.base + part.count, dtype=np.uint32)
+    within a level): one compaction scan per level, whose counts are the histogram of levels
+    (read back, as the paper reads back its HistoPyramids' tops); and the events."""
+    scan = level_scan(tessellator.context)
     queues, events = [], []
     for level in range(max_level + 1):
-        out, count, event = cl_algorithm.copy_if(
-            patches, "patch_level(factors, ary[i]) == level", preamble=LEVEL_PREAMBLE,
-            extra_args=[("factors", plan.factors), ("level", np.int32(level))], queue=tessellator.queue)
-        events.append(event)
-        queues.append(LevelQueue(level, out, int(count.get())))
+        queue = cl_array.empty(tessellator.queue, part.count, np.uint32)
+        count = cl_array.empty(tessellator.queue, 1, np.uint32)
+        events.append(scan(plan.factors, np.uint32(part.base), np.int32(level), queue, count, size=part.count,
+                           queue=tessellator.queue))
+        queues.append(LevelQueue(level, queue, int(count.get()[0])))
     return queues, events
 
 
