@@ -90,7 +90,9 @@ class Tessellator:
         Give a ``Request``, or its parts as keyword arguments (``Request.of``): exactly one of
         ``eps`` (object-space tolerance) and ``pixels`` (screen-space, needs ``scene.camera``),
         ``max_factor``, ``forward_differencing``, ``sharp_edges`` (meshes only: "straight",
-        "average" or "keep", ``cltess.kinds.pn.pn_edge_normals``; only "keep" may leave cracks).
+        "average" or "keep", ``cltess.kinds.pn.pn_edge_normals``; only "keep" may leave cracks),
+        ``pattern`` ("semi_uniform", "transition" or a pattern's name) and ``max_level`` (the
+        semi-uniform patterns' largest level, default 6).
         """
         plan = self.plan(scene, request, **options)
         return self.emit(plan, 0, plan.num_patches)
