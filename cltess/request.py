@@ -5,6 +5,7 @@ eps=..., ...)`` builds one from its keyword arguments (``Request.of``)."""
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 
 from .criteria.base import DEFAULT_MAX_FACTOR
@@ -53,7 +54,7 @@ class Request:
             raise ValueError(f"sharp_edges must be one of {', '.join(SHARP_EDGE_MODES)}, got {self.sharp_edges!r}")
         if self.pattern is not None and self.pattern not in PATTERNS and self.pattern not in FAMILIES:
             raise ValueError(f"unknown pattern {self.pattern!r}; expected one of {', '.join((*FAMILIES, *PATTERNS))}")
-        if not (isinstance(self.max_level, int) and not isinstance(self.max_level, bool)
+        if not (isinstance(self.max_level, numbers.Integral) and not isinstance(self.max_level, bool)
                 and 0 <= self.max_level <= MAX_LEVEL):
             raise ValueError(f"max_level must be an integer in 0..{MAX_LEVEL}, got {self.max_level!r}")
 
