@@ -1,12 +1,11 @@
-"""Issue 11: the triangle overhead of dyadic edge levels against today's transition pattern, at
-equal eps (the same crack-free factors), before the pipeline runs the semi-uniform pattern.
+"""Issue 11: the triangle overhead of dyadic edge levels against the transition pattern, at
+equal eps: both tessellated by the pipeline (``pattern="semi_uniform"``, edge factors rounded up
+to 2^p_e, p_e = min(ceil(log2 f_e), M), in stage 1).
 
     python bench/semi_uniform_overhead.py [--max-level 6]
 
-For each scene and eps: the pipeline's final factors f_e (transition pattern, its triangle count
-as emitted), then the semi-uniform records 2^p_e, p_e = min(ceil(log2 f_e), M), counted with the
-pattern's closed forms (cltess/patterns/semi_uniform.py).  SEEDS.md 1.3 expects about 2.2x for
-quads if log f is uniformly distributed.  Host only; the device is the default (PoCL here).
+SEEDS.md 1.3 expects about 2.2x for quads if log f is uniformly distributed.  The device is the
+default one.
 """
 from __future__ import annotations
 
@@ -43,13 +42,11 @@ def main(argv=None) -> int:
     print(f"{'scene':18} {'eps':>7} {'patches':>8} {'transition':>11} {'semi-uniform':>13} {'ratio':>6}")
     for name, scene, tolerances in scenes():
         for eps in tolerances:
-            tess = tessellator.tessellate(scene, eps=eps)
-            bezier = scene.num_bezier
-            records = su.dyadic_factors(tess.factors, args.max_level)
-            dyadic = (su.counts(records[:bezier], "quad")[1].sum() + su.counts(records[bezier:], "tri")[1].sum()) // 3
-            transition = len(tess.triangles)
-            print(f"{name:18} {eps:7.0e} {len(records):8d} {transition:11d} {dyadic:13d} {dyadic / transition:6.2f}",
-                  flush=True)
+            transition = tessellator.tessellate(scene, eps=eps).num_triangles
+            dyadic = tessellator.tessellate(scene, eps=eps, pattern="semi_uniform", max_level=args.max_level,
+                                            max_factor=max(64, 1 << args.max_level)).num_triangles
+            print(f"{name:18} {eps:7.0e} {scene.num_patches:8d} {transition:11d} {dyadic:13d} "
+                  f"{dyadic / transition:6.2f}", flush=True)
     return 0
 
 

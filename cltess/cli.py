@@ -4,7 +4,8 @@
     cltess tessellate SCENE (--eps E | --eps P% | --pixels PX) [--no-fd] [--max-factor N]
                       [--max-memory SIZE] [--sharp-edges {straight,average,keep}] [--crease-angle DEG]
                       [--no-orient] [--no-weld] [--uv {drop,seam}] [--max-output SIZE]
-                      [--preview PNG] [--device NAME] [--quiet] -o OUT
+                      [--preview PNG] [--pattern {transition,semi-uniform}] [--max-level L]
+                      [--check-t-junctions] [--device NAME] [--quiet] -o OUT
     cltess render SCENE (--eps E | --eps P% | --pixels PX) [--size W[xH]] [--color {shade,factor}]
                   [the scene options of tessellate] -o PNG
     cltess bench [SCENES...] [--device NAME] [--repeat N] [--warmup N] [--no-baseline] [--json OUT]
@@ -133,6 +134,22 @@ def _crease_angle(text: str) -> float:
     return value
 
 
+#: --pattern's choices: the pattern families (cltess.patterns.FAMILIES), as the command line spells them.
+PATTERN_CHOICES = {"transition": "transition", "semi-uniform": "semi_uniform"}
+
+
+def _max_level(text: str) -> int:
+    from cltess.request import MAX_LEVEL
+
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
+    if not 0 <= value <= MAX_LEVEL:
+        raise argparse.ArgumentTypeError(f"must be in 0..{MAX_LEVEL}, got {value}")
+    return value
+
+
 def _memory_size(text: str) -> int:
     from cltess.stream import parse_size
 
@@ -201,6 +218,13 @@ def build_parser() -> argparse.ArgumentParser:
     shared.add_argument("--orient", action=argparse.BooleanOptionalAction, default=True,
                         help="turn patches to face one way across shared edges and outwards (signed volume); "
                              "on by default, --no-orient leaves them as the file has them")
+    shared.add_argument("--pattern", choices=tuple(PATTERN_CHOICES), default="transition",
+                        help="tessellation pattern of every patch: transition strips between edge factors "
+                             "(default), or semi-uniform (Dyken et al. 2009: a uniform 2^m grid per patch, "
+                             "edges snapped to their own dyadic level; factors rounded up to powers of two)")
+    shared.add_argument("--max-level", type=_max_level, default=6, metavar="L",
+                        help="semi-uniform: the largest level (edge factor 2^L; default 6); a patch that "
+                             "needs more is saturated")
     shared.add_argument("-q", "--quiet", action="store_true",
                         help="print nothing on success, no progress bar (warnings still go to stderr)")
 
@@ -222,6 +246,9 @@ def build_parser() -> argparse.ArgumentParser:
                           f"default {DEFAULT_MAX_OUTPUT // 2**30}G; none: no limit)")
     run.add_argument("--preview", metavar="PNG",
                      help="also draw the result into this .png (as 'cltess render' does)")
+    run.add_argument("--check-t-junctions", action="store_true",
+                     help="read the output back (.ply, .npz) and count its T-junctions after exact "
+                          "welding (cltess.checks; slow on large meshes)")
     run.add_argument("-o", "--output", required=True, metavar="OUT",
                      help=f"output mesh: {', '.join(SUPPORTED_EXTENSIONS)}")
 
@@ -460,7 +487,7 @@ def cmd_tessellate(args) -> int:
     mesh_options = {"sharp_edges": args.sharp_edges} if scene.meshes else {}
     def before_writing(plan):
         """After stages 1-3, before anything big exists: warn, estimate, refuse."""
-        _warn_saturated(int(plan.stats.get("saturated", 0)), args.max_factor)
+        _warn_saturated(int(plan.stats.get("saturated", 0)), args)
         size = estimate_output_bytes(output.suffix, plan.num_vertices, plan.num_indices // 3, weld,
                                      args.uv == "seam")
         seconds = estimate_write_seconds(output.suffix, size, plan.num_indices // 3, weld)
@@ -489,13 +516,15 @@ def cmd_tessellate(args) -> int:
             on_batch=(lambda batch: drawing.add(batch.positions, batch.triangles, normals=batch.normals))
             if drawing else None,
             eps=args.eps, pixels=args.pixels, max_factor=args.max_factor, forward_differencing=not args.no_fd,
-            **mesh_options)
+            pattern=PATTERN_CHOICES[args.pattern], max_level=args.max_level, **mesh_options)
     if drawing is not None:
         from cltess.render import write_png
 
         write_png(preview, drawing.image())
     if result.batches > 1:
         result.stats["batches"] = result.batches
+    if args.check_t_junctions:
+        result.stats["t_junctions"] = _count_t_junctions(output, weld)
     if orientation is not None:
         result.stats.update(orientation.stats())
 
@@ -530,8 +559,9 @@ def cmd_render(args) -> int:
 
     tessellator = Tessellator(device=device)
     mesh_options = {"sharp_edges": args.sharp_edges} if scene.meshes else {}
-    plan = tessellator.plan(scene, eps=args.eps, pixels=args.pixels, max_factor=args.max_factor, **mesh_options)
-    _warn_saturated(int(plan.stats.get("saturated", 0)), args.max_factor)
+    plan = tessellator.plan(scene, eps=args.eps, pixels=args.pixels, max_factor=args.max_factor,
+                            pattern=PATTERN_CHOICES[args.pattern], max_level=args.max_level, **mesh_options)
+    _warn_saturated(int(plan.stats.get("saturated", 0)), args)
     budget = args.max_memory or default_budget(tessellator.device)
     drawing = Rasteriser(view_for(scene, *args.size))
     progress, bar = _progress(args, str(output))
@@ -554,12 +584,15 @@ def cmd_render(args) -> int:
     return EXIT_OK
 
 
-def _warn_saturated(saturated: int, max_factor: int) -> None:
+def _warn_saturated(saturated: int, args) -> None:
     if saturated:
         patches = "1 patch reaches" if saturated == 1 else f"{saturated} patches reach"
         verb = "does" if saturated == 1 else "do"
-        print(f"{PROG}: warning: {patches} --max-factor {max_factor} and {verb} not meet the error "
-              "bound; raise --max-factor", file=sys.stderr)
+        cap = f"--max-factor {args.max_factor}" if args.pattern == "transition" else \
+            f"--max-factor {args.max_factor} or 2^--max-level {args.max_level}"
+        raise_it = "--max-factor" if args.pattern == "transition" else "them"
+        print(f"{PROG}: warning: {patches} {cap} and {verb} not meet the error bound; raise {raise_it}",
+              file=sys.stderr)
 
 
 def _duration(seconds: float) -> str:
@@ -578,8 +611,27 @@ def _human(size: int) -> str:
     return f"{size} B"
 
 
+def _count_t_junctions(output: Path, welded: bool) -> int | str:
+    """T-junctions of the written mesh (cltess.checks.t_junctions), or why not: a per-patch
+    .ply or .npz is read back with its object ids, a welded mesh through trimesh (one object)."""
+    from cltess.batch import read_output
+    from cltess.checks import t_junctions
+
+    if welded:
+        import numpy as np
+        import trimesh
+
+        mesh = trimesh.load(output, process=False, force="mesh")
+        return len(t_junctions(np.asarray(mesh.vertices, np.float32), np.asarray(mesh.faces)))
+    mesh = read_output(output)
+    if mesh is None:
+        return f"not checked ({output.suffix} is not read back; write .ply or .npz)"
+    return len(t_junctions(mesh.positions, mesh.triangles, mesh.object_ids))
+
+
 def format_summary(stats: dict, stage_ms: dict, scene, device: str, tolerance: str, output) -> str:
-    """The tessellate summary: counts, extra int stats, per-stage ms, output path."""
+    """The tessellate summary: counts, extra int stats, the semi-uniform level histogram, the
+    T-junction count when checked, per-stage ms, output path."""
     rows = [
         ("scene", f"{scene}  ({tolerance}, device {device})"),
         ("patches", f"{stats.get('patches', '?')}  (culled {stats.get('culled', '?')}, "
@@ -590,6 +642,11 @@ def format_summary(stats: dict, stage_ms: dict, scene, device: str, tolerance: s
     for name, value in stats.items():
         if name not in _MAIN_STATS + _HIDDEN_STATS and isinstance(value, int) and not isinstance(value, bool):
             rows.append((name.replace("_", " "), value))
+    if stats.get("patch_levels"):
+        rows.append(("patch levels", ", ".join(f"{level}: {count}" for level, count in
+                                               enumerate(stats["patch_levels"]) if count)))
+    if isinstance(stats.get("t_junctions"), str):
+        rows.append(("t junctions", stats["t_junctions"]))
     if stage_ms:
         rows.append(("stage ms", ", ".join(f"{name} {ms:.3f}" for name, ms in stage_ms.items())))
     rows.append(("wrote", output))

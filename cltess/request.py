@@ -5,13 +5,18 @@ eps=..., ...)`` builds one from its keyword arguments (``Request.of``)."""
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 
 from .criteria.base import DEFAULT_MAX_FACTOR
 from .criteria.tolerance import ObjectSpace, ScreenSpace
 from .kinds import SHARP_EDGE_MODES
-from .limits import check_max_factor, check_patch_count, check_tolerance_value
-from .patterns import PATTERNS
+from .limits import MAX_FACTOR, check_max_factor, check_patch_count, check_tolerance_value
+from .patterns import FAMILIES, PATTERNS, pattern_named
+from .patterns.semi_uniform import DEFAULT_MAX_LEVEL
+
+#: The largest max_level: 2^level within the kernels' factor limit (cltess.limits.MAX_FACTOR).
+MAX_LEVEL = MAX_FACTOR.bit_length() - 1
 from .scene import Scene
 
 
@@ -24,7 +29,11 @@ class Request:
     sharp_edges:    what a mesh edge with different normals on its sides becomes ("straight",
                     "average" or "keep"; cltess.kinds.pn.pn_edge_normals); other kinds ignore it.
     pattern:        a registered pattern name for the kinds of its domain (the others keep their
-                    own), or None for each kind's own.
+                    own), a family name ("transition", "semi_uniform": its pattern of each kind's
+                    domain), or None for each kind's own.
+    max_level:      a dyadic pattern's (semi-uniform) largest edge level: factors are rounded up
+                    to 2^ceil(log2 f), at most 2^max_level (beyond it the patch is saturated);
+                    other patterns ignore it.
     """
 
     tolerance: ObjectSpace | ScreenSpace
@@ -32,6 +41,7 @@ class Request:
     forward_differencing: bool = True
     sharp_edges: str = "straight"
     pattern: str | None = None
+    max_level: int = DEFAULT_MAX_LEVEL
 
     def __post_init__(self):
         value = self.tolerance.eps if isinstance(self.tolerance, ObjectSpace) else self.tolerance.pixels
@@ -42,8 +52,11 @@ class Request:
         check_max_factor(self.max_factor)
         if self.sharp_edges not in SHARP_EDGE_MODES:
             raise ValueError(f"sharp_edges must be one of {', '.join(SHARP_EDGE_MODES)}, got {self.sharp_edges!r}")
-        if self.pattern is not None and self.pattern not in PATTERNS:
-            raise ValueError(f"unknown pattern {self.pattern!r}; expected one of {', '.join(PATTERNS)}")
+        if self.pattern is not None and self.pattern not in PATTERNS and self.pattern not in FAMILIES:
+            raise ValueError(f"unknown pattern {self.pattern!r}; expected one of {', '.join((*FAMILIES, *PATTERNS))}")
+        if not (isinstance(self.max_level, numbers.Integral) and not isinstance(self.max_level, bool)
+                and 0 <= self.max_level <= MAX_LEVEL):
+            raise ValueError(f"max_level must be an integer in 0..{MAX_LEVEL}, got {self.max_level!r}")
 
     @classmethod
     def of(cls, eps: float | None = None, pixels: float | None = None, **options) -> "Request":
@@ -71,5 +84,5 @@ class Request:
     def pattern_for(self, kind):
         """The pattern a kind is tessellated with: the requested one where its domain is the
         kind's, else the kind's own."""
-        chosen = PATTERNS.get(self.pattern) if self.pattern is not None else None
-        return chosen if chosen is not None and chosen.domain == kind.domain else kind.pattern
+        chosen = pattern_named(self.pattern, kind.domain) if self.pattern is not None else None
+        return chosen if chosen is not None else kind.pattern

@@ -149,6 +149,27 @@ inline int edge_factor(float inverse, int max_factor, int *saturated)
     return max_factor;
 }
 
+/* The record of a dyadic pattern (semi-uniform, Dyken et al. 2009): each factor f rounded up to
+ * 2^p, p = min(ceil(log2 f), max_level), exactly (ceil(log2 f) = 32 - clz(f - 1) for f > 1); 0
+ * stays 0 (culled).  Where the cap lowers a factor the bound is not met: *saturated.  Monotone,
+ * so it commutes with the crack-free max over an edge group.  max_level is an input per call, so
+ * a criterion may set an edge's level otherwise (e.g. by silhouette). */
+inline int dyadic_factor(int f, int max_level, int *saturated)
+{
+    if (f <= 0)
+        return 0;
+    int level = f > 1 ? 32 - (int)clz(f - 1) : 0;
+    if (level > max_level)
+        *saturated = 1;
+    return 1 << min(level, max_level);
+}
+
+inline int4 dyadic_factors(int4 f, int max_level, int *saturated)
+{
+    return (int4)(dyadic_factor(f.s0, max_level, saturated), dyadic_factor(f.s1, max_level, saturated),
+                  dyadic_factor(f.s2, max_level, saturated), dyadic_factor(f.s3, max_level, saturated));
+}
+
 /* Why a patch has no output, in stage 1's flags (bit 0 is "saturated"). */
 #define FLAG_SATURATED 1
 #define FLAG_CULLED 2

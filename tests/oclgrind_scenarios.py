@@ -18,7 +18,8 @@ the kernels: uniform patterns, one and two transition regions (adjacent and oppo
 factors of 1 next to larger ones, saturated factors, culled patches and their neighbours,
 everything culled (no output at all), collapsed edges, edges shared by three patches, rational
 weights, forward differencing on and off, more patches than one work-group, batched output, PN
-triangles (transitions, all factors 1, a sharp edge, an open boundary) and a scene of both kinds.
+triangles (transitions, all factors 1, a sharp edge, an open boundary), a scene of both kinds,
+and the semi-uniform patterns (snapped edges, the level cap, both kinds with culling).
 
 ``--fill-by-copy`` makes ``pyopencl.enqueue_fill`` (behind ``pyopencl.array.zeros``) copy a
 host buffer instead: Oclgrind's uninitialised-value plugin does not see clEnqueueFillBuffer, so
@@ -247,6 +248,27 @@ def mixed_culled():
     return scene, dict(pixels=2.0, max_factor=8)
 
 
+def semi_uniform():
+    """The semi-uniform pattern (issue 11): a 2x2 grid whose patches have different levels, so
+    edges below a patch's level are snapped (dyadic rounding in stage 1, FD on)."""
+    scene, _ = two_transitions_adjacent()
+    return scene, dict(eps=0.1, max_factor=8, pattern="semi_uniform")
+
+
+def semi_uniform_capped_direct():
+    """Semi-uniform at max_level 1 beside a flat patch: the curved patch is capped (saturated)
+    at level 1, the flat one's edges are at level 0 (the level-0 tie of the snap), direct
+    evaluation."""
+    scene, _ = flat_next_to_curved()
+    return scene, dict(eps=0.1, pattern="semi_uniform", max_level=1, forward_differencing=False)
+
+
+def pn_semi_uniform_mixed_culled():
+    """Semi-uniform on both kinds, part of each culled: snapped PN edges beside culled ones."""
+    scene, options = mixed_culled()
+    return scene, dict(options, pattern="semi_uniform", max_level=3)
+
+
 SCENARIOS = {
     "uniform": uniform,
     "one_transition": one_transition,
@@ -266,11 +288,18 @@ SCENARIOS = {
     "pn_icosphere": pn_icosphere,
     "pn_coarse_direct": pn_coarse_direct,
     "mixed_culled": mixed_culled,
+    "semi_uniform": semi_uniform,
+    "semi_uniform_capped_direct": semi_uniform_capped_direct,
+    "pn_semi_uniform_mixed_culled": pn_semi_uniform_mixed_culled,
 }
 
 #: Scenarios run through Tessellator.tessellate_in_batches (if the pipeline has it) with this
 #: output cap in bytes, so stages 4-5 run on sub-ranges of the patches.
 BATCHED = {"many_patches_batched": ("many_patches", 4096)}
+
+#: Scenarios whose stage 4 runs by level (cltess/backends/opencl/levels.py emit_by_level).
+BY_LEVEL = {"semi_uniform_by_level": "semi_uniform",
+            "pn_semi_uniform_mixed_culled_by_level": "pn_semi_uniform_mixed_culled"}
 
 
 # --------------------------------------------------------------------------- self-tests
@@ -344,6 +373,12 @@ def run_scenario(name: str, tessellator, out_dir: Path) -> dict:
                                for k in ("positions", "normals", "uv", "patch_ids", "object_ids",
                                          "triangles", "factors")},
                             stats=dict(parts[0].stats, batches=len(parts)))
+    elif name in BY_LEVEL:
+        from cltess.backends.opencl.levels import emit_by_level, plan_by_level
+        from cltess.request import Request
+
+        scene, options = SCENARIOS[BY_LEVEL[name]]()
+        tess = emit_by_level(tessellator, plan_by_level(tessellator, scene, Request.of(**options)))
     else:
         scene, options = SCENARIOS[name]()
         tess = tessellator.tessellate(scene, **options)

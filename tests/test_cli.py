@@ -74,9 +74,9 @@ class FakeTessellator:
         return self.emit(self.plan(scene, eps, pixels, max_factor), 0, 1, forward_differencing)
 
     # The CLI streams through cltess.stream, which calls plan() once and emit() per batch.
-    def plan(self, scene, eps=None, pixels=None, max_factor=64):
+    def plan(self, scene, eps=None, pixels=None, max_factor=64, pattern=None, max_level=6):
         FakeTessellator.calls.append(dict(scene=scene, eps=eps, pixels=pixels, max_factor=max_factor,
-                                          device=self.device))
+                                          pattern=pattern, max_level=max_level, device=self.device))
         if isinstance(FakeTessellator.result, BaseException):
             raise FakeTessellator.result
         return FakePlan(FakeTessellator.result)
@@ -196,6 +196,9 @@ def test_named_failing_device_exits_1_with_a_short_error(capsys, monkeypatch, tm
     (["--eps", "1e-3", "--max-factor", "0"], "--max-factor"),
     (["--eps", "1e-3", "--max-factor", "2.5"], "--max-factor"),
     (["--eps", "1e-3", "--pixels", "1"], "not allowed"),
+    (["--eps", "1e-3", "--pattern", "uniform"], "--pattern"),
+    (["--eps", "1e-3", "--max-level", "15"], "--max-level"),
+    (["--eps", "1e-3", "--max-level", "-1"], "--max-level"),
     ([], "--eps"),
 ])
 def test_bad_arguments_exit_2_before_any_work(capsys, tmp_path, scene_file, fake_pipeline, arguments, fragment):
@@ -310,6 +313,7 @@ def test_defaults(capsys, tmp_path, scene_file, fake_pipeline):
     assert code == 0
     (call,) = fake_pipeline.calls
     assert call["max_factor"] == 64 and call["forward_differencing"] is True
+    assert call["pattern"] == "transition" and call["max_level"] == 6
     assert (tmp_path / "m.npz").exists()
 
 
@@ -371,6 +375,23 @@ def test_tessellate_end_to_end(capsys, tmp_path, scene_file):
     assert int(summary["triangles"]) == len(mesh.faces)
     assert int(summary["vertices"]) == len(mesh.vertices)
     assert summary["wrote"] == str(out_path)
+
+
+@pytest.mark.parametrize("extension", [".ply", ".npz"])
+def test_semi_uniform_end_to_end_with_levels_and_t_junctions(capsys, tmp_path, extension):
+    """--pattern semi-uniform: the summary's level histogram and T-junction
+    count (0: the pattern snaps each edge to its own level)."""
+    out_path = tmp_path / f"teapot{extension}"
+    scene = Path(__file__).resolve().parents[1] / "scenes" / "teapot.bez"
+    code, out, err = run(capsys, "tessellate", scene, "--eps", "1e-2", "--pattern", "semi-uniform",
+                         "--max-level", "5", "--check-t-junctions", "-o", out_path)
+    assert code == 0, err
+    summary = dict(line.split(None, 1) for line in out.replace("t junctions", "t_junctions")
+                   .replace("patch levels", "patch_levels").splitlines())
+    assert summary["t_junctions"] == "0"
+    levels = dict(item.split(": ") for item in summary["patch_levels"].split(", "))
+    assert len(levels) > 1 and max(int(level) for level in levels) <= 5
+    assert sum(int(count) for count in levels.values()) == int(summary["patches"].split()[0])
 
 
 def test_python_dash_m_runs(tmp_path):

@@ -35,7 +35,7 @@ from cltess.device import list_devices
 from cltess.io.npz import load_npz
 
 HERE = Path(__file__).resolve().parent
-NAMES = [*scenarios.SCENARIOS, *scenarios.BATCHED]
+NAMES = [*scenarios.SCENARIOS, *scenarios.BATCHED, *scenarios.BY_LEVEL]
 
 PASSES = {
     "checks": dict(env=scenarios.OCLGRIND_ENV, args=[],
@@ -197,6 +197,19 @@ def test_scenarios_reach_every_code_path(oclgrind, tmp_path_factory):
     bezier_count = stats["mixed_culled"]["patches"] - stats["mixed_culled"]["pn_triangles"]
     assert (mixed[:bezier_count, 0] == 0).any() and (mixed[bezier_count:, 0] == 0).any(), "both kinds culled"
     assert (mixed[:bezier_count, 0] > 0).any() and (mixed[bezier_count:, 0] > 0).any(), "both kinds visible"
+
+    def snapped(rows, edges):  # semi-uniform patches with an edge below the patch's level
+        rows = rows[rows[:, 0] > 0, :edges]
+        assert (rows & (rows - 1) == 0).all(), "dyadic records"
+        return ((rows.min(axis=1) < rows.max(axis=1))).any()
+
+    mixed = factors["pn_semi_uniform_mixed_culled"]
+    bezier_count = stats["pn_semi_uniform_mixed_culled"]["patches"] - stats["pn_semi_uniform_mixed_culled"]["pn_triangles"]
+    assert snapped(factors["semi_uniform"], 4) and snapped(mixed[bezier_count:], 3), "snapped edges of both kinds"
+    assert (mixed[:, 0] == 0).any() and snapped(mixed[:bezier_count], 4) is not None
+    capped = factors["semi_uniform_capped_direct"]
+    assert stats["semi_uniform_capped_direct"]["saturated"] > 0 and (capped <= 2).all()
+    assert ((capped.min(axis=1) == 1) & (capped.max(axis=1) == 2)).any(), "level-0 edges in a level-1 patch"
 
     from cltess.adjacency import edge_groups
 

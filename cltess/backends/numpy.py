@@ -13,6 +13,7 @@ from ..crack.adjacency import crack_free_factors, merge_edge_groups
 from ..kinds import FACTOR_SLOTS, FLAG_CULLED, FLAG_SATURATED, KINDS
 from ..kinds import kind as kind_named
 from ..patterns import quad_pattern, tri_pattern
+from ..patterns.semi_uniform import dyadic_factors, level_histogram
 from ..request import Request
 from ..scene import Scene
 from ..surfaces.bezier import evaluate
@@ -24,6 +25,14 @@ def counts(factors: np.ndarray, kind="bezier") -> tuple[np.ndarray, np.ndarray]:
     """(vertex counts (P,), index counts (P,)) of each patch's pattern; kind: a registered kind or
     its name (its default pattern)."""
     return kind_named(kind).pattern.counts(factors)
+
+
+def dyadic_stage(factors: np.ndarray, flags: np.ndarray, max_level: int) -> tuple[np.ndarray, np.ndarray]:
+    """Stage 1's rounding for a dyadic pattern (kernels/stages/factors.cl, -D PATTERN_DYADIC):
+    factors 2^min(ceil(log2 f), max_level), 0 kept; saturated where the cap lowered a factor."""
+    rounded = dyadic_factors(factors, max_level)
+    capped = (rounded < factors).any(axis=1)
+    return rounded, flags | np.where(capped, FLAG_SATURATED, 0).astype(flags.dtype)
 
 
 def offsets(counts_: np.ndarray) -> np.ndarray:
@@ -109,7 +118,10 @@ class NumpyBackend:
                 continue
             host = kind.prepare(scene, request.sharp_edges)
             controls, f, fl = kind.reference_factors(host.source, request.tolerance_for(scene), request.max_factor)
-            parts.append((kind, request.pattern_for(kind), base, count, controls))
+            pattern = request.pattern_for(kind)
+            if pattern.dyadic:  # stage 1's rounding (common.h dyadic_factors)
+                f, fl = dyadic_stage(f, fl, request.max_level)
+            parts.append((kind, pattern, base, count, controls))
             inputs.append(host)
             factors.append(f)
             flags.append(fl)
@@ -123,6 +135,9 @@ class NumpyBackend:
             vertex_counts[b:b + count], index_counts[b:b + count] = pattern.counts(final[b:b + count])
         stats = {"patches": base, "culled": int(np.count_nonzero(flags & FLAG_CULLED)),
                  "saturated": int(np.count_nonzero(flags & FLAG_SATURATED))}
+        if any(pattern.dyadic for _, pattern, _, _, _ in parts):
+            stats["patch_levels"] = level_histogram(np.concatenate(
+                [final[b:b + count] for _, pattern, b, count, _ in parts if pattern.dyadic]))
         return NumpyPlan(scene.name, base, parts, np.concatenate([h.objects for h in inputs]), final,
                          offsets(vertex_counts), offsets(index_counts), stats)
 

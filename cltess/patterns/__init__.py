@@ -1,9 +1,25 @@
 """Tessellation patterns by name (docs/extending.md: to add one, write its NumPy mirror here and
-its header under kernels/patterns/, and add it to PATTERNS)."""
+its header under kernels/patterns/, and add it to PATTERNS).  A family name ("transition",
+"semi_uniform") selects the family's pattern of each domain (``pattern_named``)."""
 from .base import Pattern
 from .quad_transition import QUAD_TRANSITION, quad_pattern
+from .semi_uniform import QUAD_SEMI_UNIFORM, TRI_SEMI_UNIFORM
 from .tri_transition import TRI_TRANSITION, tri_pattern
 
-PATTERNS: dict[str, Pattern] = {p.name: p for p in (QUAD_TRANSITION, TRI_TRANSITION)}
+PATTERNS: dict[str, Pattern] = {p.name: p for p in (QUAD_TRANSITION, TRI_TRANSITION, QUAD_SEMI_UNIFORM,
+                                                     TRI_SEMI_UNIFORM)}
+#: Family names, each with one pattern per domain.
+FAMILIES: tuple[str, ...] = tuple(dict.fromkeys(p.family for p in PATTERNS.values() if p.family))
 
-__all__ = ["PATTERNS", "Pattern", "QUAD_TRANSITION", "TRI_TRANSITION", "quad_pattern", "tri_pattern"]
+
+def pattern_named(name: str, domain: str) -> Pattern | None:
+    """The pattern called ``name`` (a pattern or a family name) for a domain, or None when it has
+    none for that domain."""
+    chosen = PATTERNS.get(name)
+    if chosen is not None:
+        return chosen if chosen.domain == domain else None
+    return next((p for p in PATTERNS.values() if p.family == name and p.domain == domain), None)
+
+
+__all__ = ["FAMILIES", "PATTERNS", "Pattern", "QUAD_SEMI_UNIFORM", "QUAD_TRANSITION", "TRI_SEMI_UNIFORM",
+           "TRI_TRANSITION", "pattern_named", "quad_pattern", "tri_pattern"]

@@ -18,6 +18,10 @@ class Pattern:
     edges:     factors per patch it reads (4 for quads, 3 for triangles).
     header:    its device header under kernels/ (the contract of docs/extending.md).
     crack:     the crack policy its boundary needs, a header under kernels/ ("crack/max.h").
+    family:    the name that selects it for every domain (``Request(pattern="semi_uniform")``:
+               quad_semi_uniform for quads, tri_semi_uniform for triangles).
+    dyadic:    it reads dyadic factors 2^p_e: stage 1 rounds the kind's factors up to powers of
+               two, capped at 2^max_level (``-D PATTERN_DYADIC``, common.h dyadic_factors).
     layout:    the NumPy mirror, f -> (uv (V, 2) float64, triangles (T, 3) int64 local indices):
                the ring first, then the interior rows, as the device lays the vertices out.
     """
@@ -29,6 +33,13 @@ class Pattern:
     layout: Callable[[tuple], tuple[np.ndarray, np.ndarray]]
     crack: str = "crack/max.h"
     primitive: str = "triangles"
+    family: str = ""
+    dyadic: bool = False
+
+    @property
+    def defines(self) -> dict:
+        """What stage 1 is built with for this pattern (-D), besides the tolerance's."""
+        return {"PATTERN_DYADIC": 1} if self.dyadic else {}
 
     def counts(self, factors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(vertex counts (P,), index counts (P,)) of each patch's pattern."""

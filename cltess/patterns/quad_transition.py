@@ -83,4 +83,4 @@ def quad_pattern(f: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray]:
     return np.array(uv, float).reshape(-1, 2), np.array(tris, np.int64).reshape(-1, 3)
 
 
-QUAD_TRANSITION = Pattern("quad_transition", "quad", 4, "patterns/quad_transition.h", quad_pattern)
+QUAD_TRANSITION = Pattern("quad_transition", "quad", 4, "patterns/quad_transition.h", quad_pattern, family="transition")

@@ -1,5 +1,6 @@
 """Semi-uniform adaptive patch tessellation (Dyken, Reimers and Seland, CGF 2009, section 3):
-NumPy mirror of kernels/patterns/semi_uniform.h.
+NumPy mirror of kernels/patterns/semi_uniform.h, and the registry entries QUAD_SEMI_UNIFORM and
+TRI_SEMI_UNIFORM (family "semi_uniform": ``Request(pattern="semi_uniform")``).
 
 A patch at level ``m`` is the uniform dyadic pattern ``P^m`` (a 2^m x 2^m grid split along
 the diagonals (i, j)-(i+1, j+1) for a quad, 4^m triangles for a triangle).  Edge e carries its
@@ -25,14 +26,17 @@ with a transition pattern is sampled at the same points):
 
 Record (the int4 the device reads): the dyadic edge factors ``f_e = 2^p_e`` (0: culled), so that
 the ring is ``f_e`` points per edge as for every pattern, the crack-free max over an edge group
-keeps them dyadic, and ``2^m = max_e f_e``.  :func:`dyadic_factors` makes it from today's
-factors: ``p_e = min(ceil(log2 f_e), M)``, ``m = max_e p_e``.
+keeps them dyadic, and ``2^m = max_e f_e``.  Stage 1 makes it from the kind's factors
+(common.h ``dyadic_factors``, the patterns being ``dyadic``); :func:`dyadic_factors` is its
+mirror: ``p_e = min(ceil(log2 f_e), M)``, ``m = max_e p_e``.
 """
 from __future__ import annotations
 
 from functools import lru_cache
 
 import numpy as np
+
+from .base import Pattern
 
 #: The default maximum level M (issue 11: --max-level); 2^6 = the default maximum factor.
 DEFAULT_MAX_LEVEL = 6
@@ -67,6 +71,14 @@ def dyadic_factors(factors, max_level: int = DEFAULT_MAX_LEVEL) -> np.ndarray:
     int32 of the input's shape (PN factors (f0, f1, f2, 0) keep their 0)."""
     levels, _ = edge_levels(factors, max_level)
     return np.where(levels >= 0, np.left_shift(1, np.maximum(levels, 0)), 0).astype(np.int32)
+
+
+def level_histogram(records) -> list[int]:
+    """Patches per level m = log2 max_e f_e of records of dyadic factors (P, 4), culled ones
+    left out: [patches at level 0, level 1, ...] up to the highest level present."""
+    records = np.asarray(records, np.int64).reshape(-1, 4)
+    sizes = records[records[:, 0] > 0].max(axis=1)
+    return np.bincount(ceil_log2(sizes)).tolist() if len(sizes) else []
 
 
 def record_levels(record, domain: str) -> tuple[int, list[int]]:
@@ -209,6 +221,12 @@ def tri_pattern(record) -> tuple[np.ndarray, np.ndarray]:
     return pattern("tri", record)
 
 
+QUAD_SEMI_UNIFORM = Pattern("quad_semi_uniform", "quad", 4, "patterns/quad_semi_uniform.h", quad_pattern,
+                            family="semi_uniform", dyadic=True)
+TRI_SEMI_UNIFORM = Pattern("tri_semi_uniform", "tri", 3, "patterns/tri_semi_uniform.h", tri_pattern,
+                           family="semi_uniform", dyadic=True)
+
+
 def counts(records, domain: str) -> tuple[np.ndarray, np.ndarray]:
     """(vertex counts (P,), index counts (P,)) of records (P, 4), from the closed forms: the
     stage-3 mirror (reference.counts for the transition patterns)."""
@@ -220,6 +238,6 @@ def counts(records, domain: str) -> tuple[np.ndarray, np.ndarray]:
     return out[0], out[1]
 
 
-__all__ = ["DEFAULT_MAX_LEVEL", "EDGES", "ceil_log2", "edge_levels", "dyadic_factors", "record_levels", "snap",
+__all__ = ["DEFAULT_MAX_LEVEL", "EDGES", "ceil_log2", "edge_levels", "dyadic_factors", "level_histogram", "record_levels", "snap",
            "edge_point", "edge_parameter", "phi", "uniform_triangles", "lattice_layout", "vertex_count",
-           "triangle_count", "pattern", "quad_pattern", "tri_pattern", "counts"]
+           "triangle_count", "pattern", "quad_pattern", "tri_pattern", "counts", "QUAD_SEMI_UNIFORM", "TRI_SEMI_UNIFORM"]

@@ -89,4 +89,4 @@ def tri_pattern(f) -> tuple[np.ndarray, np.ndarray]:
 
 
 
-TRI_TRANSITION = Pattern("tri_transition", "tri", 3, "patterns/tri_transition.h", tri_pattern)
+TRI_TRANSITION = Pattern("tri_transition", "tri", 3, "patterns/tri_transition.h", tri_pattern, family="transition")

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from cltess.patterns.semi_uniform import dyadic_factors
+
 
 def random_factors(rng, count, high=70):
     """(count, 4) quad factors: random (transitions), uniform, culled (0), all 1."""
@@ -33,5 +35,7 @@ def random_triangle_factors(rng, count, high=40):
 
 
 def random_pattern_factors(rng, pattern, count, high=40):
-    """Random final factors for a registered pattern (by its domain)."""
-    return {"quad": random_factors, "tri": random_triangle_factors}[pattern.domain](rng, count, high)
+    """Random final factors for a registered pattern (by its domain); a dyadic pattern's rounded
+    up to powers of two as stage 1 does (levels up to ceil(log2 high))."""
+    factors = {"quad": random_factors, "tri": random_triangle_factors}[pattern.domain](rng, count, high)
+    return dyadic_factors(factors, max_level=30) if pattern.dyadic else factors

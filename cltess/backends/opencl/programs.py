@@ -26,6 +26,8 @@ STAGE_AXES = {
     "counts": ("pattern",),
     "vertices": ("kind", "pattern"),
     "indices": ("pattern",),
+    # stage 4 by level (levels.py), for a pattern with a template: built when it is asked for
+    "level_vertices": ("kind", "pattern"),
 }
 
 
@@ -36,12 +38,16 @@ def kernel_dir() -> Path:
 
 def composition(stage: str, kind=None, pattern=None, tolerance=None, crack: str = "crack/max.h"):
     """(headers, defines) of a stage's program: the kind's and pattern's headers (objects with a
-    ``header``), the crack policy's header, and the tolerance's ``defines`` (stage 1 only)."""
+    ``header``), the crack policy's header, and the tolerance's and the pattern's ``defines``
+    (stage 1 only: ``-D PATTERN_DYADIC`` rounds the factors for a dyadic pattern)."""
     parts = {"kind": kind and kind.header, "pattern": pattern and pattern.header, "crack": crack}
     headers = tuple(parts[axis] for axis in STAGE_AXES[stage])  # stage 1 also reads the tolerance
     if None in headers:
         raise ValueError(f"stage {stage} needs {', '.join(STAGE_AXES[stage])}")
-    defines = dict(tolerance.defines) if stage == "factors" and tolerance is not None else {}
+    defines = {}
+    if stage == "factors":  # the tolerance field, and the rounding a dyadic pattern asks for
+        defines.update(tolerance.defines if tolerance is not None else {})
+        defines.update(pattern.defines if pattern is not None else {})
     return headers, defines
 
 

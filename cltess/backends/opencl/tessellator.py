@@ -32,6 +32,7 @@ from ...limits import OutputTooLarge, check_totals
 from ...kinds import BEZIER, FACTOR_SLOTS, FLAG_CULLED, FLAG_SATURATED, KINDS, PN, PatchKind
 from ...kinds import kind as kind_named
 from ...patterns import PATTERNS, Pattern
+from ...patterns.semi_uniform import DEFAULT_MAX_LEVEL, level_histogram
 from ...request import Request
 from ...scene import Scene
 from ...tessellation import BYTES_PER_INDEX, BYTES_PER_VERTEX, VERTEX_RECORD, Tessellation
@@ -89,7 +90,9 @@ class Tessellator:
         Give a ``Request``, or its parts as keyword arguments (``Request.of``): exactly one of
         ``eps`` (object-space tolerance) and ``pixels`` (screen-space, needs ``scene.camera``),
         ``max_factor``, ``forward_differencing``, ``sharp_edges`` (meshes only: "straight",
-        "average" or "keep", ``cltess.kinds.pn.pn_edge_normals``; only "keep" may leave cracks).
+        "average" or "keep", ``cltess.kinds.pn.pn_edge_normals``; only "keep" may leave cracks),
+        ``pattern`` ("semi_uniform", "transition" or a pattern's name) and ``max_level`` (the
+        semi-uniform patterns' largest level, default 6).
         """
         plan = self.plan(scene, request, **options)
         return self.emit(plan, 0, plan.num_patches)
@@ -132,7 +135,7 @@ class Tessellator:
         events = {"factors": []}
         for part in parts:
             events["factors"] += self.stage_factors_of(part.kind, part.data, tolerance, request.max_factor,
-                                                       factors, flags, part.base)
+                                                       factors, flags, part.base, part.pattern, request.max_level)
         groups = scene.prepared(("edge groups", sharp_edges), lambda: merge_edge_groups(
             [(host.groups, part.kind.edges, part.base) for host, part in zip(inputs, parts)], count, FACTOR_SLOTS))
         final, events["crack_free"] = self.stage_crack_free(factors, groups)
@@ -154,8 +157,13 @@ class Tessellator:
         }
         for host in inputs:
             stats.update(host.stats)
+        read_back = {}
+        if any(part.pattern.dyadic for part in parts):  # the semi-uniform patches' levels
+            read_back["factors"] = final.get()
+            stats["patch_levels"] = level_histogram(np.concatenate(
+                [read_back["factors"][p.base:p.base + p.count] for p in parts if p.pattern.dyadic]))
         return Plan(scene.name, count, parts, objects, final, vertex_offsets, index_offsets,
-                    num_vertices, num_indices, stats, events, started, request)
+                    num_vertices, num_indices, stats, events, started, request, _host=read_back)
 
     def upload(self, kind: PatchKind, source: np.ndarray) -> dict:
         """Device arrays of a kind: "source" (one row per patch) for stage 1, "controls" what
@@ -241,13 +249,17 @@ class Tessellator:
                                        _tolerance(eps, pixels, camera), max_factor, factors, flags)
         return controls, factors, flags, events
 
-    def stage_factors_of(self, kind, data, tolerance, max_factor, factors, flags, patch_base=0):
+    def stage_factors_of(self, kind, data, tolerance, max_factor, factors, flags, patch_base=0, pattern=None,
+                         max_level=DEFAULT_MAX_LEVEL):
         """Stage 1 for a kind: data its device arrays (``upload``), tolerance an ObjectSpace or
-        ScreenSpace; writes factors and flags of its patches at patch_base.., and returns the events."""
+        ScreenSpace; writes factors and flags of its patches at patch_base.., and returns the events.
+        pattern: the kind's own unless given; a dyadic one rounds the factors to 2^p_e,
+        p_e <= max_level."""
         count = len(data["source"])
-        event = self.programs.kernel("factors", kind=kind, tolerance=tolerance)(
+        event = self.programs.kernel("factors", kind=kind, tolerance=tolerance, pattern=pattern or kind.pattern)(
             self.queue, _global_size(count), None, data["source"].data, data["controls"].data, np.uint32(count),
-            np.uint32(patch_base), *tolerance.kernel_args(), np.int32(max_factor), factors.data, flags.data)
+            np.uint32(patch_base), *tolerance.kernel_args(), np.int32(max_factor), np.int32(max_level),
+            factors.data, flags.data)
         return [event]
 
     def stage_crack_free(self, factors, groups):

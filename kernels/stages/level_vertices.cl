@@ -1,0 +1,37 @@
+/* Stage 4 by level, for a pattern with a template (the semi-uniform one: patterns/semi_uniform.h
+ * pattern_template_point): the paper's per-level instanced draws (Dyken et al. 2009, section
+ * 4.2) as one launch per level over (queue slot, template point).  queue: the scene numbers of
+ * the patches of level `level` (cltess/backends/opencl/levels.py level_scan, one stream
+ * compaction per level).  Each vertex goes where stages/vertices.cl puts it and is computed as
+ * it computes it with direct evaluation (kind_boundary_point on the ring, kind_eval inside), so
+ * the output is bitwise that of the patch-parallel stage 4 without forward differencing. */
+__kernel void level_vertices(__global const float4 *controls, __global const int4 *factors,
+                             __global const ulong *vertex_offsets, __global const int *patch_objects,
+                             __global const uint *queue, uint queue_size, int level, uint patch_base,
+                             __global float *positions, __global float *normals, __global float *uv,
+                             __global int *patch_ids, __global int *object_ids)
+{
+    ulong size = (ulong)pattern_template_size(level), id = get_global_id(0);
+    if (id >= queue_size * size)
+        return;
+    uint p = queue[id / size];
+    int4 f = factors[p];
+    template_point point = pattern_template_point(f, level, (int)(id % size));
+    if (point.vertex < 0)
+        return;  /* snapped away */
+    vertex_out out = {positions, normals, uv, patch_ids, object_ids};
+    kind_patch patch;
+    kind_load(controls, p - patch_base, &patch);
+    ulong at = vertex_offsets[p] + (ulong)point.vertex;
+    float3 position, normal;
+    if (point.edge >= 0) {
+        edge_param t = pattern_ring_param(f, point.edge, point.k);
+        float3 x = pattern_edge_point(point.edge, t);
+        kind_eval(&patch, x, 0, &normal);  /* the normal; the position is the edge's */
+        put_vertex(out, at, kind_boundary_point(&patch, point.edge, t), normal, x.xy, p, patch_objects[p]);
+    } else {
+        float3 x = pattern_row_point(f, point.j, point.i);
+        kind_eval(&patch, x, &position, &normal);
+        put_vertex(out, at, position, normal, x.xy, p, patch_objects[p]);
+    }
+}
