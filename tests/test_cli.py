@@ -22,7 +22,7 @@ from cltess.device import DEVICE_ENV_VAR, list_devices
 from cltess.limits import OutputTooLarge
 from cltess.scene import Scene
 from cltess.tessellation import Tessellation
-from device_faults import UNKNOWN_CPU_LOG, UNKNOWN_CPU_REASON, fresh_probes, pocl_fails_to_build
+from support.device_faults import UNKNOWN_CPU_LOG, UNKNOWN_CPU_REASON, fresh_probes, pocl_fails_to_build
 
 REPO = Path(__file__).resolve().parents[1]
 

@@ -21,7 +21,7 @@ from cltess.device import (
     probe_device,
 )
 
-from device_faults import UNKNOWN_CPU_LOG, UNKNOWN_CPU_REASON, fresh_probes, pocl_fails_to_build
+from support.device_faults import UNKNOWN_CPU_LOG, UNKNOWN_CPU_REASON, fresh_probes, pocl_fails_to_build
 
 @pytest.fixture(autouse=True)
 def isolated_probes(monkeypatch, tmp_path):
