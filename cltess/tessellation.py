@@ -19,8 +19,21 @@ BYTES_PER_VERTEX = sum(np.dtype(dtype).itemsize * int(np.prod(shape)) for _, dty
 BYTES_PER_INDEX = 4
 
 
+class IndexedMesh:
+    """What every mesh of cltess answers: its vertex and triangle counts (``positions`` (V, 3),
+    ``triangles`` (T, 3))."""
+
+    @property
+    def num_vertices(self) -> int:
+        return len(self.positions)
+
+    @property
+    def num_triangles(self) -> int:
+        return len(self.triangles)
+
+
 @dataclass
-class Tessellation:
+class Tessellation(IndexedMesh):
     """A triangle mesh sampled from a scene's patches, with its per-patch bookkeeping.
 
     positions:  (V, 3) float32
@@ -46,14 +59,6 @@ class Tessellation:
     factors: np.ndarray
     stage_ms: dict = field(default_factory=dict)
     stats: dict = field(default_factory=dict)
-
-    @property
-    def num_vertices(self) -> int:
-        return len(self.positions)
-
-    @property
-    def num_triangles(self) -> int:
-        return len(self.triangles)
 
     def welded(self, uv: str = "drop", check_t_junctions: bool = True):
         """One indexed mesh per object, shared boundary vertices merged exactly

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .checks import exact_weld, t_junctions
+from .tessellation import IndexedMesh
 
 __all__ = ["UV_MODES", "WeldedMesh", "weld", "edge_counts"]
 
@@ -35,7 +36,7 @@ T_JUNCTION_CHECK_LIMIT = 1_000_000
 
 
 @dataclass
-class WeldedMesh:
+class WeldedMesh(IndexedMesh):
     """An indexed triangle mesh, one vertex per distinct (object, position).
 
     positions (W, 3) float32, normals (W, 3) float32 unit, object_ids (W,) int32;
@@ -55,20 +56,12 @@ class WeldedMesh:
     stats: dict = field(default_factory=dict)
     stage_ms: dict = field(default_factory=dict)
 
-    @property
-    def num_vertices(self) -> int:
-        return len(self.positions)
-
-    @property
-    def num_triangles(self) -> int:
-        return len(self.triangles)
-
     def to_trimesh(self):
         """A ``trimesh.Trimesh`` of it (not processed: vertices and faces stay as they are),
         with the vertex normals."""
-        import trimesh
+        from .io.trimesh_formats import to_trimesh
 
-        return trimesh.Trimesh(self.positions, self.triangles, vertex_normals=self.normals, process=False)
+        return to_trimesh(self)
 
 
 def edge_counts(triangles: np.ndarray) -> dict:
