@@ -154,6 +154,10 @@ inline int edge_factor(float inverse, int max_factor, int *saturated)
 #define FLAG_CULLED 2
 #define FLAG_FOLDED 4
 
+/* Whether a patch has output: culled and folded patches have all factors 0.  A single 0 is a
+ * collapsed edge (stage 2: zero_edges), whose one point is the next corner's. */
+inline int has_output(int4 f) { return f.s0 > 0 || f.s1 > 0 || f.s2 > 0 || f.s3 > 0; }
+
 /* Stages 4 and 5 run on one batch of patches, first_patch .. first_patch + num_patches - 1
  * (scene numbering).  Sets this work-item's patch p and its factors f; 0 when it has nothing
  * to emit (past the batch's end, or culled). */
@@ -163,7 +167,7 @@ inline int batch_patch(uint first_patch, uint num_patches, __global const int4 *
         return 0;
     *p = first_patch + (uint)get_global_id(0);
     *f = factors[*p];
-    return f->s0 > 0;
+    return has_output(*f);
 }
 
 inline void load_patch(__global const float4 *patches, uint p, float4 b[16])

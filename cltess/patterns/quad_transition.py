@@ -7,6 +7,11 @@ import numpy as np
 from .base import Pattern
 
 
+def _core(a: int, b: int) -> int:
+    """The smaller of two opposite factors, a collapsed edge's 0 aside (its strip is a fan)."""
+    return b if a == 0 else a if b == 0 else min(a, b)
+
+
 def quad_pattern(f: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray]:
     """The tessellation pattern of a quad patch with edge factors f (CudaTess Fig. 3).
 
@@ -15,19 +20,22 @@ def quad_pattern(f: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray]:
     ``(i / A, j / B)`` for ``j = 1..B-1``, ``i = 1..A-1`` row by row.
 
     Uniform (f0 = f2 and f1 = f3): the regular A x B grid, A = f0, B = f1.  Otherwise the core
-    factors are ``A = max(min(f0, f2), 2)``, ``B = max(min(f1, f3), 2)``; the inner grid's cells
+    factors are ``A = max(min(f0, f2), 2)``, ``B = max(min(f1, f3), 2)`` (a 0 left out); the inner grid's cells
     are split regularly and each edge's strip between boundary and inner grid is stitched
     Bresenham-style, advancing the side whose next segment midpoint comes first.
 
+    A collapsed edge has factor 0: no ring points, its strip fans from the next corner (whose
+    ring point ``ring(e, 0)`` then is).
+
     Returns (uv (V, 2) float64, triangles (T, 3) int64 local indices, counter-clockwise in uv).
-    Culled patches (any factor 0) have no vertices and no triangles.
+    Culled patches (all factors 0) have no vertices and no triangles.
     """
     f = [int(x) for x in f]
-    if min(f) <= 0:
+    if max(f) <= 0:
         return np.zeros((0, 2)), np.zeros((0, 3), np.int64)
-    uniform = f[0] == f[2] and f[1] == f[3]
-    a = f[0] if uniform else max(min(f[0], f[2]), 2)
-    b = f[1] if uniform else max(min(f[1], f[3]), 2)
+    uniform = f[0] == f[2] and f[1] == f[3] and min(f) > 0
+    a = f[0] if uniform else max(_core(f[0], f[2]), 2)
+    b = f[1] if uniform else max(_core(f[1], f[3]), 2)
     ring_size = sum(f)
     base = np.cumsum([0] + f)
 

@@ -10,13 +10,17 @@
 
 #define PATTERN_EDGES 4
 
-/* Core grid factors: the regular grid when uniform, else the inner grid of the ring pattern. */
+/* The smaller of two opposite factors, a collapsed edge's 0 aside (its strip is a fan). */
+inline int core_factor(int a, int b) { return a == 0 ? b : b == 0 ? a : min(a, b); }
+
+/* Core grid factors: the regular grid when uniform, else the inner grid of the ring pattern.
+ * A collapsed edge has factor 0 (stages/crack_free.cl): its strip fans from the next corner. */
 inline int2 quad_core(int4 f, int *uniform)
 {
-    *uniform = f.s0 == f.s2 && f.s1 == f.s3;
+    *uniform = f.s0 == f.s2 && f.s1 == f.s3 && f.s0 > 0 && f.s1 > 0;
     if (*uniform)
         return (int2)(f.s0, f.s1);
-    return (int2)(max(min(f.s0, f.s2), 2), max(min(f.s1, f.s3), 2));
+    return (int2)(max(core_factor(f.s0, f.s2), 2), max(core_factor(f.s1, f.s3), 2));
 }
 
 /* --- the vertex layout ------------------------------------------------------------------------ */
@@ -101,7 +105,7 @@ inline void grid_cells(__global uint *out, uint *count, uint base, pattern_grid 
 inline uint pattern_primitives(int4 f, __global uint *out, uint base)
 {
     uint count = 0;
-    if (f.s0 <= 0)
+    if (!has_output(f))
         return 0;
     pattern_grid g = quad_grid(f);
     int a = g.core.x, b = g.core.y;

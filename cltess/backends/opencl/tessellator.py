@@ -252,14 +252,17 @@ class Tessellator:
 
     def stage_crack_free(self, factors, groups):
         """Stage 2.  factors (P, 4) int32 and edge groups over its P * 4 entries
-        (cltess.adjacency, or merge_edge_groups for several kinds) -> (P, 4) int32."""
+        (cltess.adjacency, or merge_edge_groups for several kinds) -> (P, 4) int32; the
+        groups' zero_edges (collapsed edges) get 0."""
         edges = factors.size
-        group_of, group_start, members = (cl_array.to_device(self.queue, a.astype(np.int32))
-                                          for a in (groups.group_of, groups.group_start, groups.members))
+        zero_edges = np.zeros(edges, bool) if groups.zero_edges is None else groups.zero_edges
+        group_of, group_start, members, zero = (
+            cl_array.to_device(self.queue, a.astype(np.int32))
+            for a in (groups.group_of, groups.group_start, groups.members, zero_edges))
         final = cl_array.empty(self.queue, factors.shape, np.int32)
         event = self.programs.kernel("crack_free")(
             self.queue, _global_size(edges), None, factors.data, group_of.data, group_start.data,
-            members.data, np.uint32(edges), final.data)
+            members.data, zero.data, np.uint32(edges), final.data)
         return final, [event]
 
     def stage_counts(self, factors, kind=BEZIER):
