@@ -52,9 +52,9 @@ class EdgeGroups:
     self_glued:  groups holding two edges of the same patch.
     reversed_pairs: shared pairs whose two curves run in the same direction (inconsistent
                  patch orientation; consistently oriented neighbours run opposite ways).
-    zero_edges:  (EP,) bool or None: patch-edges whose final factor is 0 (Bézier edges
-                 collapsed to a point, e.g. a sphere's pole: no segments, the edge's one point
-                 is the next corner, and no triangle joins its two coincident corners).
+    collapsed_edges: (EP,) bool or None: the collapsed Bézier patch-edges (a sphere's pole, the
+                 teapot lid's centre), whose final factors stage 2 stores negated: all their
+                 points are their first corner, and no triangle joins two of them.
     """
 
     group_of: np.ndarray
@@ -67,7 +67,7 @@ class EdgeGroups:
     nonmanifold: int
     self_glued: int
     reversed_pairs: int
-    zero_edges: np.ndarray | None = None
+    collapsed_edges: np.ndarray | None = None
 
     @property
     def num_groups(self) -> int:
@@ -138,7 +138,7 @@ def edge_groups(patches: np.ndarray) -> EdgeGroups:
         keys = np.ascontiguousarray(bits).view(np.dtype((np.void, 16 * 8))).ravel()
         _, inverse = np.unique(keys, return_inverse=True)
     groups = _grouped(inverse.ravel(), collapsed, flipped, palindrome, edges_per_patch=4)
-    groups.zero_edges = collapsed
+    groups.collapsed_edges = collapsed
     return groups
 
 
@@ -198,21 +198,21 @@ def merge_edge_groups(parts, num_patches: int, slots: int = 4) -> EdgeGroups:
         return parts[0][0]
     labels = np.full(total, -1, np.int64)
     flipped = np.zeros(total, bool)
-    zero_edges = np.zeros(total, bool)
+    collapsed_edges = np.zeros(total, bool)
     offset = 0
     for groups, edges, base in parts:
         count = len(groups.group_of) // edges
         entries = (slots * (base + np.arange(count))[:, None] + np.arange(edges)).reshape(-1)
         labels[entries] = groups.group_of + offset
         flipped[entries] = groups.flipped
-        if groups.zero_edges is not None:
-            zero_edges[entries] = groups.zero_edges
+        if groups.collapsed_edges is not None:
+            collapsed_edges[entries] = groups.collapsed_edges
         offset += groups.num_groups
     unused = labels < 0
     merged = _grouped(labels[~unused], unused, flipped, unused, slots)
     counts = {name: sum(getattr(groups, name) for groups, _, _ in parts)
               for name in ("shared", "boundary", "collapsed", "nonmanifold", "self_glued", "reversed_pairs")}
-    return dataclasses.replace(merged, zero_edges=zero_edges, **counts)
+    return dataclasses.replace(merged, collapsed_edges=collapsed_edges, **counts)
 
 
 def _hash_rows(bits: np.ndarray) -> np.ndarray:
@@ -227,17 +227,19 @@ def _hash_rows(bits: np.ndarray) -> np.ndarray:
 
 
 def crack_free_factors(factors: np.ndarray, group_of: np.ndarray, group_start: np.ndarray,
-                       members: np.ndarray, zero_edges: np.ndarray | None = None) -> np.ndarray:
+                       members: np.ndarray, collapsed_edges: np.ndarray | None = None) -> np.ndarray:
     """The crack policy "max" (NumPy mirror of kernels/crack/max.h and stages/crack_free.cl):
-    each patch edge takes the max factor over all patch edges of its group; culled stay 0, and so
-    do ``zero_edges`` (EdgeGroups.zero_edges: collapsed edges).
+    each patch edge takes the max factor over all patch edges of its group; culled stay 0;
+    ``collapsed_edges`` (EdgeGroups.collapsed_edges) are stored negated.
 
     factors: (P, 4); group_of: (4P,); group_start: (G+1,); members: (4P,).  Returns (P, 4).
     """
     flat = factors.reshape(-1)
     out = np.zeros_like(flat)
     for edge, group in enumerate(group_of):
-        if flat[edge] == 0 or (zero_edges is not None and zero_edges[edge]):
+        if flat[edge] == 0:
             continue
         out[edge] = max(flat[members[k]] for k in range(group_start[group], group_start[group + 1]))
+        if collapsed_edges is not None and collapsed_edges[edge]:
+            out[edge] = -out[edge]
     return out.reshape(factors.shape)

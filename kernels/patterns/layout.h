@@ -9,7 +9,7 @@
 
 inline uint pattern_vertex_count(int4 f)
 {
-    if (!has_output(f))
+    if (f.s0 <= 0)
         return 0;
     uint count = (uint)(f.s0 + f.s1 + f.s2 + f.s3);  /* the ring; unused factor slots are 0 */
     int rows = pattern_rows(f);

@@ -10,17 +10,13 @@
 
 #define PATTERN_EDGES 4
 
-/* The smaller of two opposite factors, a collapsed edge's 0 aside (its strip is a fan). */
-inline int core_factor(int a, int b) { return a == 0 ? b : b == 0 ? a : min(a, b); }
-
-/* Core grid factors: the regular grid when uniform, else the inner grid of the ring pattern.
- * A collapsed edge has factor 0 (stages/crack_free.cl): its strip fans from the next corner. */
+/* Core grid factors: the regular grid when uniform, else the inner grid of the ring pattern. */
 inline int2 quad_core(int4 f, int *uniform)
 {
-    *uniform = f.s0 == f.s2 && f.s1 == f.s3 && f.s0 > 0 && f.s1 > 0;
+    *uniform = f.s0 == f.s2 && f.s1 == f.s3;
     if (*uniform)
         return (int2)(f.s0, f.s1);
-    return (int2)(max(core_factor(f.s0, f.s2), 2), max(core_factor(f.s1, f.s3), 2));
+    return (int2)(max(min(f.s0, f.s2), 2), max(min(f.s1, f.s3), 2));
 }
 
 /* --- the vertex layout ------------------------------------------------------------------------ */
@@ -88,32 +84,38 @@ inline uint pattern_grid_index(pattern_grid g, int2 point)
 
 #include "patterns/stitch.h"
 
-inline void grid_cells(__global uint *out, uint *count, uint base, pattern_grid g, int i0, int i1, int j0, int j1)
+/* Cells i0..i1-1 x j0..j1-1 of the grid, two triangles each; a triangle with a side on a
+ * collapsed edge (bit e of collapsed) joins two coincident points and is left out. */
+inline void grid_cells(__global uint *out, uint *count, uint base, pattern_grid g, int collapsed,
+                       int i0, int i1, int j0, int j1)
 {
     for (int j = j0; j < j1; ++j)
         for (int i = i0; i < i1; ++i) {
             uint a = pattern_grid_index(g, (int2)(i, j)), b = pattern_grid_index(g, (int2)(i + 1, j));
             uint c = pattern_grid_index(g, (int2)(i + 1, j + 1)), d = pattern_grid_index(g, (int2)(i, j + 1));
-            put_triangle(out, count, base, a, b, c);
-            put_triangle(out, count, base, a, c, d);
+            if (!((j == 0 && (collapsed & 1)) || (i + 1 == g.core.x && (collapsed & 2))))
+                put_triangle(out, count, base, a, b, c);
+            if (!((j + 1 == g.core.y && (collapsed & 4)) || (i == 0 && (collapsed & 8))))
+                put_triangle(out, count, base, a, c, d);
         }
 }
 
 /* The triangles, in "count" mode (out == 0) or "emit" mode (out != 0): one routine, so the counts
  * of stage 3 and the indices of stage 5 cannot disagree.  Returns the number of triangles;
- * vertex numbers are offset by base. */
-inline uint pattern_primitives(int4 f, __global uint *out, uint base)
+ * vertex numbers are offset by base.  collapsed: bit e for a collapsed edge e (patch_factors),
+ * whose points coincide: no triangle with a side on it. */
+inline uint pattern_primitives(int4 f, int collapsed, __global uint *out, uint base)
 {
     uint count = 0;
-    if (!has_output(f))
+    if (f.s0 <= 0)
         return 0;
     pattern_grid g = quad_grid(f);
     int a = g.core.x, b = g.core.y;
     if (g.uniform) {
-        grid_cells(out, &count, base, g, 0, a, 0, b);
+        grid_cells(out, &count, base, g, collapsed, 0, a, 0, b);
         return count;
     }
-    grid_cells(out, &count, base, g, 1, a - 1, 1, b - 1);
+    grid_cells(out, &count, base, g, 0, 1, a - 1, 1, b - 1);
     /* Edge e's inner polyline runs counter-clockwise along the inner grid's boundary, its point k
      * at (k + 1) / along of the edge: segment midpoints at (2k + 3) / (2 along). */
     for (int e = 0; e < 4; ++e) {
@@ -125,7 +127,7 @@ inline uint pattern_primitives(int4 f, __global uint *out, uint base)
         row.last = along - 2;
         row.along = along;
         row.lead = 3;
-        stitch_strip(out, &count, base, g, e, row);
+        stitch_strip(out, &count, base, g, e, row, (collapsed >> e) & 1);
     }
     return count;
 }

@@ -26,6 +26,7 @@ STAGE_AXES = {
     "counts": ("pattern",),
     "vertices": ("kind", "pattern"),
     "indices": ("pattern",),
+    "verify": ("kind",),  # on request only (Tessellator.verify), so not in STAGES
 }
 
 
@@ -43,6 +44,15 @@ def composition(stage: str, kind=None, pattern=None, tolerance=None, crack: str 
         raise ValueError(f"stage {stage} needs {', '.join(STAGE_AXES[stage])}")
     defines = dict(tolerance.defines) if stage == "factors" and tolerance is not None else {}
     return headers, defines
+
+
+def correctly_rounded_division(device: cl.Device) -> list[str]:
+    """``-cl-fp32-correctly-rounded-divide-sqrt`` where the device offers it: a corner's position
+    ``h / w`` must be the float32 point that the host made it project to exactly
+    (``cltess.scene.exact_corners``: a sphere's pole is one position, issue 9 item 2).  OpenCL
+    otherwise allows 2.5 ulp for a division."""
+    config = getattr(device, "single_fp_config", 0)
+    return ["-cl-fp32-correctly-rounded-divide-sqrt"] if config & cl.device_fp_config.CORRECTLY_ROUNDED_DIVIDE_SQRT else []
 
 
 class Programs:
@@ -77,6 +87,7 @@ class Programs:
         source = "".join(f'#include "{header}"\n' for header in ("common.h", *headers))
         source += (folder / "stages" / f"{stage}.cl").read_text()
         options = ["-I", str(folder)] + [f"-D{name}={value}" for name, value in sorted(defines.items())]
+        options += correctly_rounded_division(self.context.devices[0])
         try:
             return cl.Program(self.context, source).build(options=options)
         except cl.RuntimeError as error:  # the build log is in the message

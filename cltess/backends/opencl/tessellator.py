@@ -38,6 +38,8 @@ from ...tessellation import BYTES_PER_INDEX, BYTES_PER_VERTEX, VERTEX_RECORD, Te
 from .programs import Programs
 
 WORK_GROUP = 64  # global sizes are rounded up to this; kernels guard their index
+VERIFY_ORDER = 6  # Tessellator.verify: 28 points per triangle, corners and edges included
+VERIFY_MAX_TRIANGLES = 4_000_000  # above this, every k-th triangle is verified
 
 
 @dataclass
@@ -191,8 +193,60 @@ class Tessellator:
         stage_ms = {stage: _span_ms(evs) for stage, evs in events.items() if evs}
         stage_ms["total_wall"] = (time.perf_counter() - plan.started) * 1e3
         stats = dict(plan.stats, first_patch=first, last_patch=last)
-        return Tessellation(triangles=triangles.get(), factors=plan.host_factors()[first:last],
+        return Tessellation(triangles=triangles.get(), factors=np.abs(plan.host_factors()[first:last]),
                             stage_ms=stage_ms, stats=stats, **{k: a.get() for k, a in vertices.items()})
+
+    # --- stage 6 on request: the error, measured (issue 9 item 9) ---------------------------------
+
+    def verify(self, scene: Scene, plan: "Plan", tess: Tessellation, order: int = VERIFY_ORDER,
+               max_triangles: int = VERIFY_MAX_TRIANGLES) -> dict:
+        """Measure on the device the worst |S(u,v) - mesh(u,v)| / tolerance of ``tess`` (the
+        output of ``emit(plan, ...)`` for ``scene``, one batch or all), at the barycentric points
+        of order ``order`` of every triangle (``stages/verify.cl``; float64 host mirror:
+        ``cltess.bound.worst_bound_ratio``).  Above ``max_triangles`` triangles, every k-th is
+        measured (k = "verify_stride" > 1).  Returns the stats: "verify_ratio" (the worst ratio),
+        "verify_patch" and "verify_triangle" (where: scene patch number, triangle number in
+        ``tess``), "verify_triangles" (how many were measured), "verify_stride", "verify_order",
+        "verify_ms" (device time)."""
+        from ...bound import scene_tolerances
+
+        request = plan.request
+        pixels = request.tolerance.pixels if isinstance(request.tolerance, ScreenSpace) else None
+        eps = request.tolerance.eps if isinstance(request.tolerance, ObjectSpace) else None
+        first, last = tess.stats.get("first_patch", 0), tess.stats.get("last_patch", plan.num_patches)
+        vertex_base, index_base = plan.vertex_range(first, last)[0], plan.index_range(first, last)[0]
+        count = len(tess.triangles)
+        stride = max(1, -(-count // max_triangles)) if max_triangles else 1
+        tolerances = cl_array.to_device(self.queue, scene_tolerances(scene, eps, pixels, request.sharp_edges)
+                                        .astype(np.float32))
+        positions, uv, patch_ids = (cl_array.to_device(self.queue, np.ascontiguousarray(a))
+                                    for a in (tess.positions, tess.uv, tess.patch_ids))
+        triangles = cl_array.to_device(self.queue, (tess.triangles - np.uint32(vertex_base)).astype(np.uint32))
+        worst = {"verify_ratio": 0.0, "verify_patch": -1, "verify_triangle": -1}
+        measured, events = 0, []
+        for part in plan.parts:
+            lo, hi = max(first, part.base), min(last, part.base + part.count)
+            if lo >= hi:
+                continue
+            start, stop = ((i - index_base) // 3 for i in plan.index_range(lo, hi))
+            start = -(-start // stride) * stride  # the global sample grid: triangles k * stride
+            samples = max(0, -(-(stop - start) // stride))
+            if not samples:
+                continue
+            ratios = cl_array.empty(self.queue, samples, np.float32)
+            events.append(self.programs.kernel("verify", kind=part.kind)(
+                self.queue, _global_size(samples), None, part.data["controls"].data, positions.data,
+                uv.data, patch_ids.data, triangles.data, np.uint64(start), np.uint32(stride),
+                np.uint32(samples), np.uint32(part.base), np.int32(order), tolerances.data, ratios.data))
+            host = ratios.get()
+            at = int(host.argmax())
+            if host[at] > worst["verify_ratio"] or worst["verify_triangle"] < 0:
+                triangle = start + at * stride
+                worst = {"verify_ratio": float(host[at]), "verify_triangle": triangle,
+                         "verify_patch": int(tess.patch_ids[tess.triangles[triangle, 0] - vertex_base])}
+            measured += samples
+        return dict(worst, verify_triangles=measured, verify_stride=stride, verify_order=order,
+                    verify_ms=_span_ms(events) if events else 0.0)
 
     # --- stages 4-5 from a plan made elsewhere (issue 17, cltess/batch.py) -----------------------
 
@@ -253,16 +307,16 @@ class Tessellator:
     def stage_crack_free(self, factors, groups):
         """Stage 2.  factors (P, 4) int32 and edge groups over its P * 4 entries
         (cltess.adjacency, or merge_edge_groups for several kinds) -> (P, 4) int32; the
-        groups' zero_edges (collapsed edges) get 0."""
+        groups' collapsed_edges are stored negated (kernels/common.h, patch_factors)."""
         edges = factors.size
-        zero_edges = np.zeros(edges, bool) if groups.zero_edges is None else groups.zero_edges
-        group_of, group_start, members, zero = (
+        collapsed = np.zeros(edges, bool) if groups.collapsed_edges is None else groups.collapsed_edges
+        group_of, group_start, members, collapsed = (
             cl_array.to_device(self.queue, a.astype(np.int32))
-            for a in (groups.group_of, groups.group_start, groups.members, zero_edges))
+            for a in (groups.group_of, groups.group_start, groups.members, collapsed))
         final = cl_array.empty(self.queue, factors.shape, np.int32)
         event = self.programs.kernel("crack_free")(
             self.queue, _global_size(edges), None, factors.data, group_of.data, group_start.data,
-            members.data, zero.data, np.uint32(edges), final.data)
+            members.data, collapsed.data, np.uint32(edges), final.data)
         return final, [event]
 
     def stage_counts(self, factors, kind=BEZIER):
