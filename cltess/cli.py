@@ -146,6 +146,10 @@ def build_parser() -> argparse.ArgumentParser:
                           "each side's own PN curve (may crack)")
     run.add_argument("-o", "--output", required=True, metavar="OUT",
                      help=f"output mesh: {', '.join(SUPPORTED_EXTENSIONS)}")
+    run.add_argument("--verify", action="store_true",
+                     help="after tessellating, measure on the device the worst distance between surface and "
+                          "mesh at equal (u, v), at 28 points in every triangle (every k-th triangle above "
+                          "4 million), and print it beside the requested tolerance")
     run.add_argument("-q", "--quiet", action="store_true", help="print nothing on success (warnings still go to stderr)")
 
     batch = commands.add_parser(
@@ -272,7 +276,7 @@ def cmd_tessellate(args) -> int:
     mesh_options = {"sharp_edges": args.sharp_edges} if scene.meshes else {}
     result = tessellate_to_file(tessellator, scene, output, max_memory_bytes=args.max_memory, eps=args.eps,
                                 pixels=args.pixels, max_factor=args.max_factor,
-                                forward_differencing=not args.no_fd, **mesh_options)
+                                forward_differencing=not args.no_fd, verify=args.verify, **mesh_options)
     if result.batches > 1:
         result.stats["batches"] = result.batches
 
@@ -282,6 +286,9 @@ def cmd_tessellate(args) -> int:
         verb = "does" if saturated == 1 else "do"
         print(f"{PROG}: warning: {patches} --max-factor {args.max_factor} and {verb} not meet the error "
               "bound; raise --max-factor", file=sys.stderr)
+    if result.stats.get("verify_ratio", 0.0) > 1.0:
+        print(f"{PROG}: warning: {args.scene}: measured deviation {result.stats['verify_ratio']:.4g} times the "
+              f"tolerance at patch {result.stats['verify_patch']} (--verify)", file=sys.stderr)
     if not int(result.stats.get("triangles", 0)):
         reasons = [f"{result.stats[key]} {label}" for key, label in
                    (("culled", "outside the camera's view"), ("folded_triangles", "folded mesh triangles"))
@@ -300,6 +307,16 @@ def cmd_tessellate(args) -> int:
     return EXIT_OK
 
 
+def verified_summary(stats: dict, tolerance: str) -> str:
+    """The --verify line: the worst measured |S - mesh| / tolerance beside the requested one."""
+    sampled = (f"every {stats['verify_stride']}th triangle ({stats['verify_triangles']})"
+               if stats["verify_stride"] > 1 else f"all {stats['verify_triangles']} triangles")
+    return (f"worst |S(u,v) - mesh(u,v)| = {stats['verify_ratio']:.4f} x tolerance (requested {tolerance}) "
+            f"at patch {stats['verify_patch']}, triangle {stats['verify_triangle']}; "
+            f"{sampled} at {(stats['verify_order'] + 1) * (stats['verify_order'] + 2) // 2} points each, "
+            f"{stats['verify_ms']:.1f} ms on the device")
+
+
 def format_summary(stats: dict, stage_ms: dict, scene, device: str, tolerance: str, output) -> str:
     """The tessellate summary: counts, extra int stats, per-stage ms, output path."""
     rows = [
@@ -310,8 +327,11 @@ def format_summary(stats: dict, stage_ms: dict, scene, device: str, tolerance: s
         ("triangles", stats.get("triangles", "?")),
     ]
     for name, value in stats.items():
-        if name not in _MAIN_STATS and isinstance(value, int) and not isinstance(value, bool):
+        if name not in _MAIN_STATS and not name.startswith("verify_") and isinstance(value, int) \
+                and not isinstance(value, bool):
             rows.append((name.replace("_", " "), value))
+    if "verify_ratio" in stats:
+        rows.append(("verified", verified_summary(stats, tolerance)))
     if stage_ms:
         rows.append(("stage ms", ", ".join(f"{name} {ms:.3f}" for name, ms in stage_ms.items())))
     rows.append(("wrote", output))

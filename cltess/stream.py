@@ -17,6 +17,7 @@ from pathlib import Path
 
 import pyopencl as cl
 
+from .backends.opencl.tessellator import combine_verified
 from .limits import OutputTooLarge
 from .export import ObjWriter, PlyWriter, check_extension, export
 
@@ -43,11 +44,13 @@ def default_budget(device: cl.Device) -> int:
 
 
 def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = None,
-                       **options) -> StreamResult:
+                       verify: bool = False, **options) -> StreamResult:
     """Tessellate ``scene`` into ``path`` (.ply, .obj or .npz) within ``max_memory_bytes``.
 
     options: eps / pixels / max_factor / forward_differencing, as for ``Tessellator.tessellate``.
-    A .npz file cannot be streamed: it must fit the budget in one batch.
+    A .npz file cannot be streamed: it must fit the budget in one batch.  verify: measure the
+    error of every batch on the device (``Tessellator.verify``); the stats (and a .npz file's
+    stats_json) carry "verify_ratio" and where it occurs.
     """
     path = Path(path)
     extension = check_extension(path)
@@ -64,21 +67,25 @@ def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = 
                               f"under a budget of {budget} bytes, and {extension} cannot be streamed; "
                               "write .ply or .obj, or raise the memory cap")
         tess = tessellator.emit(plan, 0, plan.num_patches, forward_differencing)
+        if verify:
+            tess.stats.update(tessellator.verify(scene, plan, tess))
         export(tess, path)
         return StreamResult(tess.stats, tess.stage_ms, 1, budget, path, ranges)
 
     stage_ms: dict = {}
-    done = []
+    done, verified = [], []
     with STREAMING_WRITERS[extension](path, plan.num_vertices, plan.num_indices // 3) as writer:
         for first, last in ranges:
             for batch in _emit_fitting(tessellator, plan, first, last, forward_differencing):
                 writer.write_vertices(batch)
                 writer.write_faces(batch.triangles)
                 done.append((batch.stats["first_patch"], batch.stats["last_patch"]))
+                if verify:
+                    verified.append(tessellator.verify(scene, plan, batch))
                 for stage, ms in batch.stage_ms.items():
                     stage_ms[stage] = ms if stage == "total_wall" else stage_ms.get(stage, 0.0) + ms
                 del batch
-    return StreamResult(dict(plan.stats), stage_ms, len(done), budget, path, done)
+    return StreamResult(dict(plan.stats, **combine_verified(verified)), stage_ms, len(done), budget, path, done)
 
 
 def _emit_fitting(tessellator, plan, first: int, last: int, forward_differencing: bool):

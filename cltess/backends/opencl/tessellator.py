@@ -204,10 +204,11 @@ class Tessellator:
         output of ``emit(plan, ...)`` for ``scene``, one batch or all), at the barycentric points
         of order ``order`` of every triangle (``stages/verify.cl``; float64 host mirror:
         ``cltess.bound.worst_bound_ratio``).  Above ``max_triangles`` triangles, every k-th is
-        measured (k = "verify_stride" > 1).  Returns the stats: "verify_ratio" (the worst ratio),
-        "verify_patch" and "verify_triangle" (where: scene patch number, triangle number in
-        ``tess``), "verify_triangles" (how many were measured), "verify_stride", "verify_order",
-        "verify_ms" (device time)."""
+        measured (k = "verify_stride" > 1: triangles k, 2k, ... of the whole mesh, so batches
+        sample as the single pass does).  Returns the stats: "verify_ratio" (the worst ratio),
+        "verify_patch" and "verify_triangle" (where: scene patch number, triangle number in the
+        whole mesh), "verify_triangles" (how many were measured), "verify_stride",
+        "verify_order", "verify_ms" (device time).  ``combine_verified`` merges batches'."""
         from ...bound import scene_tolerances
 
         request = plan.request
@@ -215,8 +216,8 @@ class Tessellator:
         eps = request.tolerance.eps if isinstance(request.tolerance, ObjectSpace) else None
         first, last = tess.stats.get("first_patch", 0), tess.stats.get("last_patch", plan.num_patches)
         vertex_base, index_base = plan.vertex_range(first, last)[0], plan.index_range(first, last)[0]
-        count = len(tess.triangles)
-        stride = max(1, -(-count // max_triangles)) if max_triangles else 1
+        stride = max(1, -(-(plan.num_indices // 3) // max_triangles)) if max_triangles else 1
+        triangle_base = index_base // 3  # tess's triangle 0 in the whole mesh
         tolerances = cl_array.to_device(self.queue, scene_tolerances(scene, eps, pixels, request.sharp_edges)
                                         .astype(np.float32))
         positions, uv, patch_ids = (cl_array.to_device(self.queue, np.ascontiguousarray(a))
@@ -228,8 +229,9 @@ class Tessellator:
             lo, hi = max(first, part.base), min(last, part.base + part.count)
             if lo >= hi:
                 continue
-            start, stop = ((i - index_base) // 3 for i in plan.index_range(lo, hi))
-            start = -(-start // stride) * stride  # the global sample grid: triangles k * stride
+            start, stop = (i // 3 for i in plan.index_range(lo, hi))
+            start = -(-start // stride) * stride - triangle_base  # the whole mesh's triangles k * stride
+            stop -= triangle_base
             samples = max(0, -(-(stop - start) // stride))
             if not samples:
                 continue
@@ -242,7 +244,7 @@ class Tessellator:
             at = int(host.argmax())
             if host[at] > worst["verify_ratio"] or worst["verify_triangle"] < 0:
                 triangle = start + at * stride
-                worst = {"verify_ratio": float(host[at]), "verify_triangle": triangle,
+                worst = {"verify_ratio": float(host[at]), "verify_triangle": triangle_base + triangle,
                          "verify_patch": int(tess.patch_ids[tess.triangles[triangle, 0] - vertex_base])}
             measured += samples
         return dict(worst, verify_triangles=measured, verify_stride=stride, verify_order=order,
@@ -376,6 +378,16 @@ class Tessellator:
             index_offsets.data, np.uint32(first), np.uint32(last - first), np.uint64(index_range[0]),
             triangles.data)
         return triangles, [event]
+
+
+def combine_verified(parts: list[dict]) -> dict:
+    """The verify stats of several batches of one mesh (Tessellator.verify) as one."""
+    parts = [p for p in parts if p]
+    if not parts:
+        return {}
+    worst = max(parts, key=lambda p: p["verify_ratio"])
+    return dict(worst, verify_triangles=sum(p["verify_triangles"] for p in parts),
+                verify_ms=sum(p["verify_ms"] for p in parts))
 
 
 @dataclass
