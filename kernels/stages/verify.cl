@@ -7,6 +7,12 @@
  * per triangle (cltess.bound.worst_bound_ratio is the float64 host mirror).  One work-item per
  * sampled triangle first + stride * gid, all of one kind (scene patch p is the kind's
  * p - patch_base). */
+/* A vertex's domain point from its (u, v): (u, v, 0) on the quad, (u, v, 1 - u - v) on the triangle. */
+inline float3 verify_domain(float2 x)
+{
+    return (float3)(x, KIND_DOMAIN_EDGES == 3 ? 1.0f - x.x - x.y : 0.0f);
+}
+
 __kernel void verify(__global const float4 *controls, __global const float *positions,
                      __global const float *uv, __global const int *patch_ids,
                      __global const uint *triangles, ulong first, uint stride, uint num_samples,
@@ -17,23 +23,21 @@ __kernel void verify(__global const float4 *controls, __global const float *posi
     if (gid >= num_samples)
         return;
     ulong t = first + (ulong)stride * gid;
-    uint corner[3] = {triangles[3 * t], triangles[3 * t + 1], triangles[3 * t + 2]};
-    uint p = (uint)patch_ids[corner[0]];
+    uint a = triangles[3 * t], b = triangles[3 * t + 1], c = triangles[3 * t + 2];
+    uint p = (uint)patch_ids[a];
     kind_patch patch;
     kind_load(controls, p - patch_base, &patch);
-    float3 position[3], domain[3];
-    for (int c = 0; c < 3; ++c) {
-        position[c] = vload3(corner[c], positions);
-        float2 x = vload2(corner[c], uv);
-        domain[c] = (float3)(x, KIND_DOMAIN_EDGES == 3 ? 1.0f - x.x - x.y : 0.0f);
-    }
+    float3 position_a = vload3(a, positions), position_b = vload3(b, positions), position_c = vload3(c, positions);
+    float3 domain_a = verify_domain(vload2(a, uv)), domain_b = verify_domain(vload2(b, uv));
+    float3 domain_c = verify_domain(vload2(c, uv));
     float worst = 0.0f;
     for (int i = 0; i <= order; ++i)
         for (int j = 0; j <= order - i; ++j) {
-            float a = (float)i / (float)order, b = (float)j / (float)order, c = (float)(order - i - j) / (float)order;
-            float3 mesh = a * position[0] + b * position[1] + c * position[2];
-            float3 x = a * domain[0] + b * domain[1] + c * domain[2];
-            float3 surface, normal;
+            float wa = (float)i / (float)order, wb = (float)j / (float)order;
+            float wc = (float)(order - i - j) / (float)order;
+            float3 mesh = wa * position_a + wb * position_b + wc * position_c;
+            float3 x = wa * domain_a + wb * domain_b + wc * domain_c;
+            float3 surface = (float3)(0.0f), normal = (float3)(0.0f);
             kind_eval(&patch, x, &surface, &normal);
             worst = fmax(worst, length(surface - mesh));
         }
