@@ -7,10 +7,13 @@
  * per triangle (cltess.bound.worst_bound_ratio is the float64 host mirror).  One work-item per
  * sampled triangle first + stride * gid, all of one kind (scene patch p is the kind's
  * p - patch_base). */
-/* A vertex's domain point from its (u, v): (u, v, 0) on the quad, (u, v, 1 - u - v) on the triangle. */
-inline float3 verify_domain(float2 x)
+/* Vertex v's domain point from its (u, v): (u, v, 0) on the quad, (u, v, 1 - u - v) on the
+ * triangle.  Scalar loads: Oclgrind's uninitialised-value pass (-O0) crashed on a float2 widened
+ * to a float3. */
+inline float3 verify_domain(__global const float *uv, uint v)
 {
-    return (float3)(x, KIND_DOMAIN_EDGES == 3 ? 1.0f - x.x - x.y : 0.0f);
+    float u = uv[2 * v], w = uv[2 * v + 1];
+    return (float3)(u, w, KIND_DOMAIN_EDGES == 3 ? 1.0f - u - w : 0.0f);
 }
 
 __kernel void verify(__global const float4 *controls, __global const float *positions,
@@ -28,8 +31,7 @@ __kernel void verify(__global const float4 *controls, __global const float *posi
     kind_patch patch;
     kind_load(controls, p - patch_base, &patch);
     float3 position_a = vload3(a, positions), position_b = vload3(b, positions), position_c = vload3(c, positions);
-    float3 domain_a = verify_domain(vload2(a, uv)), domain_b = verify_domain(vload2(b, uv));
-    float3 domain_c = verify_domain(vload2(c, uv));
+    float3 domain_a = verify_domain(uv, a), domain_b = verify_domain(uv, b), domain_c = verify_domain(uv, c);
     float worst = 0.0f;
     for (int i = 0; i <= order; ++i)
         for (int j = 0; j <= order - i; ++j) {
@@ -37,7 +39,7 @@ __kernel void verify(__global const float4 *controls, __global const float *posi
             float wc = (float)(order - i - j) / (float)order;
             float3 mesh = wa * position_a + wb * position_b + wc * position_c;
             float3 x = wa * domain_a + wb * domain_b + wc * domain_c;
-            float3 surface = (float3)(0.0f), normal = (float3)(0.0f);
+            float3 surface, normal;
             kind_eval(&patch, x, &surface, &normal);
             worst = fmax(worst, length(surface - mesh));
         }
