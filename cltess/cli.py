@@ -309,7 +309,7 @@ def cmd_tessellate(args) -> int:
 
 def verified_summary(stats: dict, tolerance: str) -> str:
     """The --verify line: the worst measured |S - mesh| / tolerance beside the requested one."""
-    sampled = (f"every {stats['verify_stride']}th triangle ({stats['verify_triangles']})"
+    sampled = (f"every {stats['verify_stride']}-th triangle ({stats['verify_triangles']})"
                if stats["verify_stride"] > 1 else f"all {stats['verify_triangles']} triangles")
     return (f"worst |S(u,v) - mesh(u,v)| = {stats['verify_ratio']:.4f} x tolerance (requested {tolerance}) "
             f"at patch {stats['verify_patch']}, triangle {stats['verify_triangle']}; "
