@@ -186,6 +186,9 @@ def build_parser() -> argparse.ArgumentParser:
     batch.add_argument("--check-bound", action="store_true",
                        help="measure each output's worst distance to the surface / tolerance into the "
                             "manifest (NumPy, on a sample of its triangles; .ply and .npz, not with --split)")
+    batch.add_argument("--verify", action="store_true",
+                       help="measure each output's worst surface-to-mesh distance / tolerance on the device "
+                            "(as tessellate --verify) into the manifest (not with --split)")
     batch.add_argument("-o", "--output", required=True, metavar="OUTDIR", help="output folder")
     batch.add_argument("-q", "--quiet", action="store_true", help="no progress bar or summary on success")
 
@@ -380,7 +383,7 @@ def cmd_batch(args) -> int:
     options = BatchOptions(eps=args.eps, pixels=args.pixels, max_factor=args.max_factor,
                            forward_differencing=not args.no_fd, sharp_edges=args.sharp_edges,
                            format=args.format, device=args.device, max_memory=args.max_memory,
-                           check_bound=args.check_bound)
+                           check_bound=args.check_bound, verify=args.verify)
     try:
         rows = tessellate_files(args.inputs, args.output, options, scheduler=args.scheduler,
                                 workers=args.workers, split=args.split, progress=Progress(enabled=not args.quiet))
