@@ -163,9 +163,6 @@ inline int4 patch_factors(int4 stored, int *collapsed)
     return as_int4(abs(stored));  /* abs of an int4 is a uint4 */
 }
 
-/* Whether a patch has output: culled and folded patches have factors 0. */
-inline int has_output(int4 f) { return f.s0 > 0; }
-
 /* Stages 4 and 5 run on one batch of patches, first_patch .. first_patch + num_patches - 1
  * (scene numbering).  Sets this work-item's patch p, its factors f and collapsed edges
  * (patch_factors); 0 when it has nothing to emit (past the batch's end, or culled). */
@@ -176,7 +173,7 @@ inline int batch_patch(uint first_patch, uint num_patches, __global const int4 *
         return 0;
     *p = first_patch + (uint)get_global_id(0);
     *f = patch_factors(factors[*p], collapsed);
-    return has_output(*f);
+    return f->s0 > 0;
 }
 
 inline void load_patch(__global const float4 *patches, uint p, float4 b[16])
