@@ -114,3 +114,31 @@ def test_cli_without_verify_measures_nothing(capsys, tmp_path):
     assert main(["tessellate", str(SCENES / "sphere.bpt"), "--eps", "1e-2", "-o", str(out)]) == 0
     assert "verified" not in capsys.readouterr().out
     assert "verify_ratio" not in json.loads(str(np.load(out)["stats_json"]))["stats"]
+
+
+@pytest.mark.parametrize("max_factor", [1024, 3], ids=["bound met", "saturated"])
+def test_verify_against_the_host_on_random_rational_patches(tessellator, rng, max_factor):
+    """Random rational patches (weights 0.2-5, with transitions), and the same clamped so that
+    they miss the bound: the device measurement is the host's within 1%."""
+    from support import random_patches
+
+    scene = Scene(random_patches(rng, 40), np.arange(40, dtype=np.int32), name="random")
+    eps = 0.02
+    plan = tessellator.plan(scene, eps=eps, max_factor=max_factor)
+    tess = tessellator.emit(plan, 0, plan.num_patches)
+    verified = tessellator.verify(scene, plan, tess)
+    host = worst_bound_ratio(scene, tess, eps=eps, order=ORDER)
+    assert abs(verified["verify_ratio"] - host) <= 0.01 * host
+    assert (tess.stats["saturated"] > 0) == (max_factor == 3) == (host > 1.0)
+
+
+def test_verify_order_and_sampling_follow_the_arguments(tessellator):
+    scene, eps = load_scene(SCENES / "torus.bpt"), 3e-3
+    plan = tessellator.plan(scene, eps=eps)
+    tess = tessellator.emit(plan, 0, plan.num_patches)
+    for order in (1, 3, 9):  # order 1: the corners only, where surface and mesh meet
+        verified = tessellator.verify(scene, plan, tess, order=order)
+        host = worst_bound_ratio(scene, tess, eps=eps, order=order)
+        assert verified["verify_order"] == order
+        assert abs(verified["verify_ratio"] - host) <= 0.01 * host + 1e-4
+    assert tessellator.verify(scene, plan, tess, order=1)["verify_ratio"] < 1e-3
