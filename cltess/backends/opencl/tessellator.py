@@ -395,7 +395,8 @@ class Plan:
     """Stages 1-3 done for a whole scene: what stages 4-5 need, on the device.
 
     parts: the kinds' patch ranges and device data (PlanPart); objects: (P,) object ids;
-    factors: (P, 4) final factors; vertex_offsets, index_offsets: (P+1,) exclusive scans with
+    factors: (P, 4) final factors (collapsed edges negated: kernels/common.h patch_factors;
+    ``Tessellation.factors`` are their absolute values); vertex_offsets, index_offsets: (P+1,) exclusive scans with
     the totals last; stats: the scene's counts (see Tessellation.stats); request: what it was
     planned for.
     """
@@ -476,7 +477,7 @@ class HostPlan:
 
     kinds: (kind name, pattern name, base, count) per part; controls: each part's stage-4
     input, (count, 16, 4) float32 (the Bézier patches, or the PN control points stage 1 made);
-    objects (P,) int32; factors (P, 4) int32, final (crack-free); vertex_offsets and
+    objects (P,) int32; factors (P, 4) int32, final (crack-free, collapsed edges negated); vertex_offsets and
     index_offsets (P+1,) uint64 with the totals last; stats as Plan.stats; request: what it
     was planned for.
     """
