@@ -72,6 +72,7 @@ class BatchOptions:
     check_bound: bool = False  # measure each output's worst error / tolerance (cltess.bound)
     weld: bool | None = None  # as tessellate --weld: None welds the mesh formats (MESH_FORMATS)
     orient: bool = True  # as tessellate --orient (cltess.orient)
+    verify: bool = False  # measure it on the device (Tessellator.verify): verify_ratio, verify_patch
 
     def __post_init__(self):
         if (self.eps is None) == (self.pixels is None):
@@ -195,7 +196,8 @@ def _unchanged(prints: list[dict]) -> bool:
     return True
 
 
-def up_to_date(row: dict | None, path: Path, output: Path, key: dict, check_bound: bool = False) -> bool:
+def up_to_date(row: dict | None, path: Path, output: Path, key: dict, check_bound: bool = False,
+               verify: bool = False) -> bool:
     """Whether a previous manifest row still describes ``output``: it succeeded with the same
     output key, its input files are unchanged and the output has the size it recorded."""
     if not row or row.get("status") not in ("done", "skipped") or row.get("options") != key:
@@ -207,6 +209,8 @@ def up_to_date(row: dict | None, path: Path, output: Path, key: dict, check_boun
         return False
     if check_bound and row.get("worst_bound_ratio") is None and output.suffix != ".obj":
         return False  # asked for now, not measured then
+    if verify and row.get("verify_ratio") is None:
+        return False
     prints = row.get("fingerprint") or []
     return bool(prints) and prints[0]["file"] == str(path) and _unchanged(prints)
 
@@ -254,7 +258,8 @@ def as_table(rows: list[dict]):
 def _row(path: Path, output: Path, key: dict, **fields) -> dict:
     row = {"input": str(path), "output": str(output), "status": "failed", "error": None,
            "patches": None, "culled": None, "saturated": None, "vertices": None, "triangles": None,
-           "output_bytes": None, "worst_bound_ratio": None, "parts": None, "seconds": None,
+           "output_bytes": None, "worst_bound_ratio": None, "verify_ratio": None, "verify_patch": None,
+           "parts": None, "seconds": None,
            **{f"{stage}_ms": None for stage in STAGE_COLUMNS}, "worker": None, "device": None,
            "options": key, "fingerprint": []}
     row.update(fields)
@@ -335,9 +340,10 @@ def tessellate_file_task(path: str, output: str, options: BatchOptions, slots: d
             kwargs.pop("sharp_edges")
         output.parent.mkdir(parents=True, exist_ok=True)
         result = tessellate_to_file(tessellator, scene, output, max_memory_bytes=options.max_memory,
-                                    weld=options.welded, **kwargs)
+                                    weld=options.welded, verify=options.verify, **kwargs)
         row.update(_counts(result.stats), status="done", output_bytes=output.stat().st_size,
-                   parts=result.batches, **{f"{s}_ms": result.stage_ms.get(s) for s in STAGE_COLUMNS})
+                   parts=result.batches, **{f"{s}_ms": result.stage_ms.get(s) for s in STAGE_COLUMNS},
+                   **{k: result.stats[k] for k in ("verify_ratio", "verify_patch") if k in result.stats})
         if options.check_bound:
             row["worst_bound_ratio"] = measure_output(scene, output, options)
     except Exception as error:  # noqa: BLE001 - any failure is this input's own, reported in its row
@@ -661,6 +667,8 @@ def tessellate_files(inputs, outdir, options: BatchOptions | None = None, *, cli
         raise ValueError(f"a split scene is joined as PLY; --format {options.format} cannot be split")
     if split is not None and options.check_bound:
         raise ValueError("--check-bound measures whole outputs on one worker; it cannot be used with --split")
+    if split is not None and options.verify:
+        raise ValueError("--verify measures whole outputs on one worker; it cannot be used with --split")
     if split is not None:
         if options.weld:
             raise ValueError("a split scene is written per patch, not welded (welding needs the whole mesh in "
@@ -671,7 +679,7 @@ def tessellate_files(inputs, outdir, options: BatchOptions | None = None, *, cli
     previous = {row.get("input"): row for row in read_manifest(outdir)["rows"]}
     rows: dict[Path, dict] = {}
     for path, output in jobs:
-        if up_to_date(previous.get(str(path)), path, output, key, options.check_bound):
+        if up_to_date(previous.get(str(path)), path, output, key, options.check_bound, options.verify):
             rows[path] = dict(previous[str(path)], status="skipped")
     todo = [(path, output) for path, output in jobs if path not in rows]
     bar = progress if isinstance(progress, Progress) else Progress(enabled=bool(progress))

@@ -19,6 +19,40 @@ from .surfaces.pn import pn_control_points, pn_surface_points
 SAMPLES_PER_CHUNK = 100_000  # bounds the memory of one evaluation (a (n, 4, 4, 4) gather)
 
 
+def _surfaces(scene, sharp_edges: str):
+    """(first scene patch number, float64 evaluator (ids, u, v) -> points) per kind."""
+    from .kinds import PN
+
+    surfaces = []
+    if scene.num_bezier:
+        patches = np.asarray(scene.patches, float)
+        surfaces.append((0, lambda ids, u, v: surface_points(patches, ids, u, v)))
+    if scene.num_triangles:
+        controls = _pn_controls(scene, sharp_edges)
+        base = scene.num_bezier
+        surfaces.append((base, lambda ids, u, v: pn_surface_points(controls, ids - base, u, v)))
+    return surfaces
+
+
+def _pn_controls(scene, sharp_edges: str) -> np.ndarray:
+    from .kinds import PN
+
+    source = scene.prepared((PN.name, sharp_edges), lambda: PN.prepare(scene, sharp_edges)).source
+    return pn_control_points(np.asarray(source, float))
+
+
+def scene_tolerances(scene, eps: float | None = None, pixels: float | None = None,
+                     sharp_edges: str = "straight") -> np.ndarray:
+    """(P,) float64: every patch's tolerance in scene numbering (Bézier patches, then PN
+    triangles), as stage 1 computes it (criteria.tolerance.patch_tolerances, filip.pn_tolerances)."""
+    tolerances = []
+    if scene.num_bezier:
+        tolerances.append(patch_tolerances(np.asarray(scene.patches, float), eps, pixels, scene.camera)[0])
+    if scene.num_triangles:
+        tolerances.append(pn_tolerances(_pn_controls(scene, sharp_edges), eps, pixels, scene.camera)[0])
+    return np.concatenate(tolerances) if tolerances else np.zeros(0)
+
+
 def worst_bound_ratio(scene, mesh, eps: float | None = None, pixels: float | None = None,
                       sharp_edges: str = "straight", order: int = 4, max_triangles: int | None = None) -> float:
     """The worst ratio over samples inside the triangles of ``mesh`` (anything with positions,
@@ -26,20 +60,7 @@ def worst_bound_ratio(scene, mesh, eps: float | None = None, pixels: float | Non
     ``eps`` or ``pixels`` (per patch, ``criteria.tolerance.patch_tolerances``).  ``max_triangles``: sample
     only every k-th triangle so that at most about this many are measured.  0.0 for no triangles.
     """
-    from .kinds import PN
-
-    surfaces, tolerances = [], []
-    if scene.num_bezier:
-        patches = np.asarray(scene.patches, float)
-        surfaces.append((0, lambda ids, u, v: surface_points(patches, ids, u, v)))
-        tolerances.append(patch_tolerances(patches, eps, pixels, scene.camera)[0])
-    if scene.num_triangles:
-        source = scene.prepared((PN.name, sharp_edges), lambda: PN.prepare(scene, sharp_edges)).source
-        controls = pn_control_points(np.asarray(source, float))
-        base = scene.num_bezier
-        surfaces.append((base, lambda ids, u, v: pn_surface_points(controls, ids - base, u, v)))
-        tolerances.append(pn_tolerances(controls, eps, pixels, scene.camera)[0])
-    tolerance = np.concatenate(tolerances)
+    surfaces, tolerance = _surfaces(scene, sharp_edges), scene_tolerances(scene, eps, pixels, sharp_edges)
     triangles = np.asarray(mesh.triangles, np.int64)
     if max_triangles and len(triangles) > max_triangles:
         triangles = triangles[::-(-len(triangles) // max_triangles)]
@@ -63,4 +84,4 @@ def worst_bound_ratio(scene, mesh, eps: float | None = None, pixels: float | Non
     return worst
 
 
-__all__ = ["worst_bound_ratio"]
+__all__ = ["scene_tolerances", "worst_bound_ratio"]

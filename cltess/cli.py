@@ -251,6 +251,10 @@ def build_parser() -> argparse.ArgumentParser:
                           "welding (cltess.checks; slow on large meshes)")
     run.add_argument("-o", "--output", required=True, metavar="OUT",
                      help=f"output mesh: {', '.join(SUPPORTED_EXTENSIONS)}")
+    run.add_argument("--verify", action="store_true",
+                     help="after tessellating, measure on the device the worst distance between surface and "
+                          "mesh at equal (u, v), at 28 points in every triangle (every k-th triangle above "
+                          "4 million), and print it beside the requested tolerance")
 
     render = commands.add_parser(
         "render", help="tessellate a scene and draw it into a PNG (no display needed)",
@@ -306,6 +310,9 @@ def build_parser() -> argparse.ArgumentParser:
                        help="measure each output's worst distance to the surface / tolerance into the "
                             "manifest (NumPy, on a sample of its triangles; .ply and .npz with --no-weld, "
                             "not with --split)")
+    batch.add_argument("--verify", action="store_true",
+                       help="measure each output's worst surface-to-mesh distance / tolerance on the device "
+                            "(as tessellate --verify) into the manifest (not with --split)")
     batch.add_argument("-o", "--output", required=True, metavar="OUTDIR", help="output folder")
     batch.add_argument("-q", "--quiet", action="store_true", help="no progress bar or summary on success")
 
@@ -516,7 +523,7 @@ def cmd_tessellate(args) -> int:
             on_batch=(lambda batch: drawing.add(batch.positions, batch.triangles, normals=batch.normals))
             if drawing else None,
             eps=args.eps, pixels=args.pixels, max_factor=args.max_factor, forward_differencing=not args.no_fd,
-            pattern=PATTERN_CHOICES[args.pattern], max_level=args.max_level, **mesh_options)
+            pattern=PATTERN_CHOICES[args.pattern], max_level=args.max_level, verify=args.verify, **mesh_options)
     if drawing is not None:
         from cltess.render import write_png
 
@@ -528,6 +535,9 @@ def cmd_tessellate(args) -> int:
     if orientation is not None:
         result.stats.update(orientation.stats())
 
+    if result.stats.get("verify_ratio", 0.0) > 1.0:
+        print(f"{PROG}: warning: {args.scene}: measured deviation {result.stats['verify_ratio']:.4g} times the "
+              f"tolerance at patch {result.stats['verify_patch']} (--verify)", file=sys.stderr)
     if not int(result.stats.get("triangles", 0)):
         reasons = [f"{result.stats[key]} {label}" for key, label in
                    (("culled", "outside the camera's view"), ("folded_triangles", "folded mesh triangles"))
@@ -629,6 +639,16 @@ def _count_t_junctions(output: Path, welded: bool) -> int | str:
     return len(t_junctions(mesh.positions, mesh.triangles, mesh.object_ids))
 
 
+def verified_summary(stats: dict, tolerance: str) -> str:
+    """The --verify line: the worst measured |S - mesh| / tolerance beside the requested one."""
+    sampled = (f"every {stats['verify_stride']}-th triangle ({stats['verify_triangles']})"
+               if stats["verify_stride"] > 1 else f"all {stats['verify_triangles']} triangles")
+    return (f"worst |S(u,v) - mesh(u,v)| = {stats['verify_ratio']:.4f} x tolerance (requested {tolerance}) "
+            f"at patch {stats['verify_patch']}, triangle {stats['verify_triangle']}; "
+            f"{sampled} at {(stats['verify_order'] + 1) * (stats['verify_order'] + 2) // 2} points each, "
+            f"{stats['verify_ms']:.1f} ms on the device")
+
+
 def format_summary(stats: dict, stage_ms: dict, scene, device: str, tolerance: str, output) -> str:
     """The tessellate summary: counts, extra int stats, the semi-uniform level histogram, the
     T-junction count when checked, per-stage ms, output path."""
@@ -640,13 +660,16 @@ def format_summary(stats: dict, stage_ms: dict, scene, device: str, tolerance: s
         ("triangles", stats.get("triangles", "?")),
     ]
     for name, value in stats.items():
-        if name not in _MAIN_STATS + _HIDDEN_STATS and isinstance(value, int) and not isinstance(value, bool):
+        if name not in _MAIN_STATS + _HIDDEN_STATS and not name.startswith("verify_") \
+                and isinstance(value, int) and not isinstance(value, bool):
             rows.append((name.replace("_", " "), value))
     if stats.get("patch_levels"):
         rows.append(("patch levels", ", ".join(f"{level}: {count}" for level, count in
                                                enumerate(stats["patch_levels"]) if count)))
     if isinstance(stats.get("t_junctions"), str):
         rows.append(("t junctions", stats["t_junctions"]))
+    if "verify_ratio" in stats:
+        rows.append(("verified", verified_summary(stats, tolerance)))
     if stage_ms:
         rows.append(("stage ms", ", ".join(f"{name} {ms:.3f}" for name, ms in stage_ms.items())))
     rows.append(("wrote", output))
@@ -695,7 +718,7 @@ def cmd_batch(args) -> int:
     options = BatchOptions(eps=args.eps, pixels=args.pixels, max_factor=args.max_factor,
                            forward_differencing=not args.no_fd, sharp_edges=args.sharp_edges,
                            format=args.format, device=args.device, max_memory=args.max_memory,
-                           check_bound=args.check_bound, weld=args.weld, orient=args.orient)
+                           check_bound=args.check_bound, weld=args.weld, orient=args.orient, verify=args.verify)
     try:
         rows = tessellate_files(args.inputs, args.output, options, scheduler=args.scheduler,
                                 workers=args.workers, split=args.split, progress=Progress(enabled=not args.quiet))

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import pyopencl as cl
 
+from .backends.opencl.tessellator import combine_verified
 from .limits import OutputTooLarge
 from .io.export import check_extension, export
 from .io.obj import ObjWriter
@@ -46,7 +47,7 @@ def default_budget(device: cl.Device) -> int:
 
 def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = None,
                        weld: bool = False, uv: str = "drop", on_plan=None, on_batch=None, progress=None,
-                       **options) -> StreamResult:
+                       verify: bool = False, **options) -> StreamResult:
     """Tessellate ``scene`` into ``path`` (.ply, .obj, .stl, .glb or .npz) within ``max_memory_bytes``.
 
     options: eps / pixels / max_factor / forward_differencing, as for ``Tessellator.tessellate``.
@@ -57,6 +58,8 @@ def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = 
     on_batch(tess): called with each batch's Tessellation (per-patch vertices, before welding),
     e.g. to draw a preview.
     progress(stage, done, total): called as batches are written.
+    verify: measure the error of every batch on the device (``Tessellator.verify``); the stats
+    (and a .npz file's stats_json) carry "verify_ratio" and where it occurs.
     """
     path = Path(path)
     extension = check_extension(path)
@@ -76,6 +79,8 @@ def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = 
             raise OutputTooLarge(f"{path}: the output ({plan.output_bytes} bytes) needs {len(ranges)} batches "
                                  f"under a budget of {budget} bytes, and {why}; {fix}, or raise the memory cap")
         tess = tessellator.emit(plan, 0, plan.num_patches, forward_differencing)
+        if verify:
+            tess.stats.update(tessellator.verify(scene, plan, tess))
         if progress is not None:
             progress("tessellated", 1, 1)
         if on_batch is not None:
@@ -87,7 +92,7 @@ def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = 
         return StreamResult(result.stats, tess.stage_ms, 1, budget, path, ranges)
 
     stage_ms: dict = {}
-    done = []
+    done, verified = [], []
     with STREAMING_WRITERS[extension](path, plan.num_vertices, plan.num_indices // 3) as writer:
         for first, last in ranges:
             for batch in _emit_fitting(tessellator, plan, first, last, forward_differencing):
@@ -98,10 +103,12 @@ def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = 
                 done.append((batch.stats["first_patch"], batch.stats["last_patch"]))
                 if progress is not None:
                     progress("batches", batch.stats["last_patch"], plan.num_patches)
+                if verify:
+                    verified.append(tessellator.verify(scene, plan, batch))
                 for stage, ms in batch.stage_ms.items():
                     stage_ms[stage] = ms if stage == "total_wall" else stage_ms.get(stage, 0.0) + ms
                 del batch
-    return StreamResult(dict(plan.stats), stage_ms, len(done), budget, path, done)
+    return StreamResult(dict(plan.stats, **combine_verified(verified)), stage_ms, len(done), budget, path, done)
 
 
 def _emit_fitting(tessellator, plan, first: int, last: int, forward_differencing: bool):

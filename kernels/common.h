@@ -175,15 +175,25 @@ inline int4 dyadic_factors(int4 f, int max_level, int *saturated)
 #define FLAG_CULLED 2
 #define FLAG_FOLDED 4
 
+/* The factors of a patch as stage 2 stores them: a collapsed edge (its control points one
+ * point, e.g. a sphere's pole) negated.  Returns the factors; *collapsed: bit e set for a
+ * collapsed edge e (its points all at its first corner; no triangle joins two of them). */
+inline int4 patch_factors(int4 stored, int *collapsed)
+{
+    *collapsed = (stored.s0 < 0) | (stored.s1 < 0) << 1 | (stored.s2 < 0) << 2 | (stored.s3 < 0) << 3;
+    return as_int4(abs(stored));  /* abs of an int4 is a uint4 */
+}
+
 /* Stages 4 and 5 run on one batch of patches, first_patch .. first_patch + num_patches - 1
- * (scene numbering).  Sets this work-item's patch p and its factors f; 0 when it has nothing
- * to emit (past the batch's end, or culled). */
-inline int batch_patch(uint first_patch, uint num_patches, __global const int4 *factors, uint *p, int4 *f)
+ * (scene numbering).  Sets this work-item's patch p, its factors f and collapsed edges
+ * (patch_factors); 0 when it has nothing to emit (past the batch's end, or culled). */
+inline int batch_patch(uint first_patch, uint num_patches, __global const int4 *factors, uint *p, int4 *f,
+                       int *collapsed)
 {
     if (get_global_id(0) >= num_patches)
         return 0;
     *p = first_patch + (uint)get_global_id(0);
-    *f = factors[*p];
+    *f = patch_factors(factors[*p], collapsed);
     return f->s0 > 0;
 }
 

@@ -293,6 +293,10 @@ SCENARIOS = {
     "pn_semi_uniform_mixed_culled": pn_semi_uniform_mixed_culled,
 }
 
+#: Scenarios whose tessellation is then measured on the device (Tessellator.verify,
+#: kernels/stages/verify.cl): both kinds, collapsed edges, culled patches.
+VERIFIED = ("rational_sphere", "pn_icosphere", "mixed_culled")
+
 #: Scenarios run through Tessellator.tessellate_in_batches (if the pipeline has it) with this
 #: output cap in bytes, so stages 4-5 run on sub-ranges of the patches.
 BATCHED = {"many_patches_batched": ("many_patches", 4096)}
@@ -381,10 +385,16 @@ def run_scenario(name: str, tessellator, out_dir: Path) -> dict:
         tess = emit_by_level(tessellator, plan_by_level(tessellator, scene, Request.of(**options)))
     else:
         scene, options = SCENARIOS[name]()
-        tess = tessellator.tessellate(scene, **options)
+        plan = tessellator.plan(scene, **options)
+        tess = tessellator.emit(plan, 0, plan.num_patches)
+        if name in VERIFIED:
+            verified = tessellator.verify(scene, plan, tess)
     write_npz(tess, out_dir / f"{name}.npz")
-    return {"name": name, "stats": {k: v for k, v in tess.stats.items() if isinstance(v, int)},
-            "factors": tess.factors.tolist()}
+    result = {"name": name, "stats": {k: v for k, v in tess.stats.items() if isinstance(v, int)},
+              "factors": tess.factors.tolist()}
+    if name in VERIFIED:
+        result["verify_ratio"] = verified["verify_ratio"]
+    return result
 
 
 def main(argv=None) -> int:

@@ -105,6 +105,27 @@ def test_rerun_skips_what_is_up_to_date(client, inputs, tmp_path):
     assert set(statuses(eps=EPS / 2).values()) == {"done", "failed"}  # new options: all redone
 
 
+def test_verify_puts_the_device_measurement_in_the_manifest(client, inputs, tmp_path, tessellator):
+    """--verify (Tessellator.verify, on the worker's device) gives each row verify_ratio and
+    verify_patch, equal to the single-process measurement; a rerun without a measurement redoes it."""
+    files = [inputs / "teapot.bez", inputs / "sphere.bpt"]
+    plain = tessellate_files(files[:1], tmp_path / "out", eps=EPS, client=client)
+    assert plain[0]["verify_ratio"] is None
+    rows = tessellate_files(files, tmp_path / "out", eps=EPS, client=client, verify=True)
+    for path, row in zip(files, rows):
+        assert row["status"] == "done"  # the teapot's too: asked for now, not measured then
+        scene = load_scene(path)
+        plan = tessellator.plan(scene, eps=EPS)
+        expected = tessellator.verify(scene, plan, tessellator.emit(plan, 0, plan.num_patches))
+        assert row["verify_ratio"] == pytest.approx(expected["verify_ratio"], rel=1e-5)
+        assert row["verify_patch"] == expected["verify_patch"] and 0.1 < row["verify_ratio"] <= 1
+    again = tessellate_files(files, tmp_path / "out", eps=EPS, client=client, verify=True)
+    assert [r["status"] for r in again] == ["skipped", "skipped"]
+    assert json.loads((tmp_path / "out" / "manifest.json").read_text())["rows"][0]["verify_ratio"] is not None
+    with pytest.raises(ValueError, match="--verify"):
+        tessellate_files(files[:1], tmp_path / "split", eps=EPS, client=client, verify=True, split=2)
+
+
 def test_check_bound_measures_each_output_as_the_tests_do(client, inputs, tmp_path, tessellator):
     """--check-bound reads each output back and measures it (cltess.bound), as support.bound_ratio
     measures the in-memory mesh; OBJ keeps no patch ids, so its ratio stays unknown."""

@@ -216,6 +216,8 @@ def test_scenarios_reach_every_code_path(oclgrind, tmp_path_factory):
     for name in ("collapsed_lid", "collapsed_bottom_direct"):
         scene, _ = scenarios.SCENARIOS[name]()
         assert edge_groups(scene.patches).collapsed > 0, name
+    for name in scenarios.VERIFIED:  # stages/verify.cl ran, and measured something
+        assert 0.0 < run.results[name]["verify_ratio"] < 1.0, name
 
 
 @pytest.mark.parametrize("pass_name", PASSES)
@@ -231,6 +233,10 @@ def test_results_match_pocl(oclgrind, tmp_path_factory, tessellator, pass_name):
         for field in ("factors", "triangles", "positions", "uv", "patch_ids", "object_ids"):
             assert np.array_equal(getattr(got, field), getattr(expected, field)), f"{name}: {field}"
         np.testing.assert_allclose(got.normals, expected.normals, rtol=0, atol=1e-6, err_msg=name)
+        if name in scenarios.VERIFIED:
+            plan = tessellator.plan(scene, **options)
+            ours = tessellator.verify(scene, plan, tessellator.emit(plan, 0, plan.num_patches))
+            assert abs(run.results[name]["verify_ratio"] - ours["verify_ratio"]) <= 1e-5, name
 
 
 # --------------------------------------------------------------------------- the device list

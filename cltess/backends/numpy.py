@@ -129,7 +129,7 @@ class NumpyBackend:
         factors, flags = np.concatenate(factors), np.concatenate(flags)
         groups = merge_edge_groups([(host.groups, kind.edges, b) for host, (kind, _, b, _, _) in zip(inputs, parts)],
                                    base, FACTOR_SLOTS)
-        final = crack_free_factors(factors, groups.group_of, groups.group_start, groups.members)
+        final = crack_free_factors(factors, groups.group_of, groups.group_start, groups.members, groups.collapsed_edges)
         vertex_counts, index_counts = np.zeros(base, np.int64), np.zeros(base, np.int64)
         for _, pattern, b, count, _ in parts:
             vertex_counts[b:b + count], index_counts[b:b + count] = pattern.counts(final[b:b + count])

@@ -25,6 +25,10 @@ import numpy as np
 
 from ..scene import boundary_curves
 
+#: A patch-edge is collapsed when its four Cartesian control points lie within this much of
+#: their magnitude of each other: float64 roundings, far below float32's 6e-8.
+COLLAPSED_RELATIVE = 1e-13
+
 __all__ = ["EdgeGroups", "edge_groups", "merge_edge_groups", "crack_free_factors"]
 
 
@@ -48,6 +52,9 @@ class EdgeGroups:
     self_glued:  groups holding two edges of the same patch.
     reversed_pairs: shared pairs whose two curves run in the same direction (inconsistent
                  patch orientation; consistently oriented neighbours run opposite ways).
+    collapsed_edges: (EP,) bool or None: the collapsed Bézier patch-edges (a sphere's pole, the
+                 teapot lid's centre), whose final factors stage 2 stores negated: all their
+                 points are their first corner, and no triangle joins two of them.
     """
 
     group_of: np.ndarray
@@ -60,6 +67,7 @@ class EdgeGroups:
     nonmanifold: int
     self_glued: int
     reversed_pairs: int
+    collapsed_edges: np.ndarray | None = None
 
     @property
     def num_groups(self) -> int:
@@ -104,9 +112,11 @@ def edge_groups(patches: np.ndarray) -> EdgeGroups:
     num_edges = 4 * len(patches)
     curves = boundary_curves(patches).reshape(num_edges, 4, 4) + 0.0  # + 0.0: -0.0 -> 0.0
 
-    # Collapsed: all four Cartesian points equal (homogeneous weights may still differ).
+    # Collapsed: all four Cartesian points one point (homogeneous weights may still differ),
+    # to within a few float64 roundings of their size (a pole moved far from the origin).
     cartesian = curves[:, :, :3] / curves[:, :, 3:]
-    collapsed = (cartesian[:, 1:] == cartesian[:, :1]).all(axis=(1, 2))
+    spread = np.abs(cartesian[:, 1:] - cartesian[:, :1]).max(axis=(1, 2))
+    collapsed = spread <= COLLAPSED_RELATIVE * np.abs(cartesian).max(axis=(1, 2))
 
     # Canonical order: the lexicographically smaller of the forward and reversed sequences.
     forward = curves.reshape(num_edges, 16)
@@ -127,7 +137,9 @@ def edge_groups(patches: np.ndarray) -> EdgeGroups:
     if not np.array_equal(bits, bits[first_open][inverse]):  # a hash collision: sort the bytes
         keys = np.ascontiguousarray(bits).view(np.dtype((np.void, 16 * 8))).ravel()
         _, inverse = np.unique(keys, return_inverse=True)
-    return _grouped(inverse.ravel(), collapsed, flipped, palindrome, edges_per_patch=4)
+    groups = _grouped(inverse.ravel(), collapsed, flipped, palindrome, edges_per_patch=4)
+    groups.collapsed_edges = collapsed
+    return groups
 
 
 def _grouped(labels: np.ndarray, collapsed: np.ndarray, flipped: np.ndarray, palindrome: np.ndarray,
@@ -186,18 +198,21 @@ def merge_edge_groups(parts, num_patches: int, slots: int = 4) -> EdgeGroups:
         return parts[0][0]
     labels = np.full(total, -1, np.int64)
     flipped = np.zeros(total, bool)
+    collapsed_edges = np.zeros(total, bool)
     offset = 0
     for groups, edges, base in parts:
         count = len(groups.group_of) // edges
         entries = (slots * (base + np.arange(count))[:, None] + np.arange(edges)).reshape(-1)
         labels[entries] = groups.group_of + offset
         flipped[entries] = groups.flipped
+        if groups.collapsed_edges is not None:
+            collapsed_edges[entries] = groups.collapsed_edges
         offset += groups.num_groups
     unused = labels < 0
     merged = _grouped(labels[~unused], unused, flipped, unused, slots)
     counts = {name: sum(getattr(groups, name) for groups, _, _ in parts)
               for name in ("shared", "boundary", "collapsed", "nonmanifold", "self_glued", "reversed_pairs")}
-    return dataclasses.replace(merged, **counts)
+    return dataclasses.replace(merged, collapsed_edges=collapsed_edges, **counts)
 
 
 def _hash_rows(bits: np.ndarray) -> np.ndarray:
@@ -212,9 +227,10 @@ def _hash_rows(bits: np.ndarray) -> np.ndarray:
 
 
 def crack_free_factors(factors: np.ndarray, group_of: np.ndarray, group_start: np.ndarray,
-                       members: np.ndarray) -> np.ndarray:
-    """The crack policy "max" (NumPy mirror of kernels/crack/max.h): each patch edge takes the max
-    factor over all patch edges of its group; culled stay 0.
+                       members: np.ndarray, collapsed_edges: np.ndarray | None = None) -> np.ndarray:
+    """The crack policy "max" (NumPy mirror of kernels/crack/max.h and stages/crack_free.cl):
+    each patch edge takes the max factor over all patch edges of its group; culled stay 0;
+    ``collapsed_edges`` (EdgeGroups.collapsed_edges) are stored negated.
 
     factors: (P, 4); group_of: (4P,); group_start: (G+1,); members: (4P,).  Returns (P, 4).
     """
@@ -224,4 +240,6 @@ def crack_free_factors(factors: np.ndarray, group_of: np.ndarray, group_start: n
         if flat[edge] == 0:
             continue
         out[edge] = max(flat[members[k]] for k in range(group_start[group], group_start[group + 1]))
+        if collapsed_edges is not None and collapsed_edges[edge]:
+            out[edge] = -out[edge]
     return out.reshape(factors.shape)

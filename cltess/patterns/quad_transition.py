@@ -19,10 +19,14 @@ def quad_pattern(f: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray]:
     are split regularly and each edge's strip between boundary and inner grid is stitched
     Bresenham-style, advancing the side whose next segment midpoint comes first.
 
+    A negative factor -f_e is a collapsed edge (stage 2, ``kernels/common.h`` patch_factors): its
+    points coincide, and the triangles with a side on it are left out.
+
     Returns (uv (V, 2) float64, triangles (T, 3) int64 local indices, counter-clockwise in uv).
-    Culled patches (any factor 0) have no vertices and no triangles.
+    Culled patches (factors 0) have no vertices and no triangles.
     """
-    f = [int(x) for x in f]
+    collapsed = [int(x) < 0 for x in f]
+    f = [abs(int(x)) for x in f]
     if min(f) <= 0:
         return np.zeros((0, 2)), np.zeros((0, 3), np.int64)
     uniform = f[0] == f[2] and f[1] == f[3]
@@ -57,16 +61,18 @@ def quad_pattern(f: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray]:
 
     tris = []
 
-    def cells(i0, i1, j0, j1):
+    def cells(i0, i1, j0, j1, collapsed):
         for j in range(j0, j1):
             for i in range(i0, i1):
-                tris.append((grid(i, j), grid(i + 1, j), grid(i + 1, j + 1)))
-                tris.append((grid(i, j), grid(i + 1, j + 1), grid(i, j + 1)))
+                if not ((j == 0 and collapsed[0]) or (i + 1 == a and collapsed[1])):
+                    tris.append((grid(i, j), grid(i + 1, j), grid(i + 1, j + 1)))
+                if not ((j + 1 == b and collapsed[2]) or (i == 0 and collapsed[3])):
+                    tris.append((grid(i, j), grid(i + 1, j + 1), grid(i, j + 1)))
 
     if uniform:
-        cells(0, a, 0, b)
+        cells(0, a, 0, b, collapsed)
     else:
-        cells(1, a - 1, 1, b - 1)
+        cells(1, a - 1, 1, b - 1, [False] * 4)
         inner_edge = [lambda k: inner(1 + k, 1), lambda k: inner(a - 1, 1 + k),
                       lambda k: inner(a - 1 - k, b - 1), lambda k: inner(1, b - 1 - k)]
         for e in range(4):
@@ -75,7 +81,8 @@ def quad_pattern(f: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray]:
             o = k = 0
             while o < outer_n or k < inner_n:
                 if k == inner_n or (o < outer_n and (2 * o + 1) * core <= (2 * k + 3) * outer_n):
-                    tris.append((ring(e, o), ring(e, o + 1), inner_edge[e](k)))
+                    if not collapsed[e]:
+                        tris.append((ring(e, o), ring(e, o + 1), inner_edge[e](k)))
                     o += 1
                 else:
                     tris.append((ring(e, o), inner_edge[e](k + 1), inner_edge[e](k)))

@@ -76,14 +76,15 @@ def dyadic_factors(factors, max_level: int = DEFAULT_MAX_LEVEL) -> np.ndarray:
 def level_histogram(records) -> list[int]:
     """Patches per level m = log2 max_e f_e of records of dyadic factors (P, 4), culled ones
     left out: [patches at level 0, level 1, ...] up to the highest level present."""
-    records = np.asarray(records, np.int64).reshape(-1, 4)
+    records = np.abs(np.asarray(records, np.int64).reshape(-1, 4))  # collapsed edges are stored negated
     sizes = records[records[:, 0] > 0].max(axis=1)
     return np.bincount(ceil_log2(sizes)).tolist() if len(sizes) else []
 
 
 def record_levels(record, domain: str) -> tuple[int, list[int]]:
-    """(m, [p_e]) of one record of dyadic factors; m = -1 when culled."""
-    f = [int(x) for x in record[:EDGES[domain]]]
+    """(m, [p_e]) of one record of dyadic factors (a collapsed edge's negated, as stage 2
+    stores it); m = -1 when culled."""
+    f = [abs(int(x)) for x in record[:EDGES[domain]]]
     if min(f) <= 0:
         return -1, []
     levels = [x.bit_length() - 1 for x in f]
@@ -210,7 +211,22 @@ def pattern(domain: str, record) -> tuple[np.ndarray, np.ndarray]:
     if m < 0:
         return np.zeros((0, 2)), np.zeros((0, 3), np.int64)
     points, triangles = lattice_layout(domain, m, levels)
-    return points / float(1 << m), triangles
+    return points / float(1 << m), triangles[~on_collapsed_edges(triangles, record, domain)]
+
+
+def on_collapsed_edges(triangles: np.ndarray, record, domain: str) -> np.ndarray:
+    """Which triangles have a side on a collapsed edge (a negative factor: its points coincide,
+    kernels/common.h patch_factors), so are left out: two of their corners among the ring points
+    of that edge, its two corners included (kernels/patterns/semi_uniform.h su_put)."""
+    f = [int(x) for x in record[:EDGES[domain]]]
+    sizes = [abs(x) for x in f]
+    ring, start = sum(sizes), np.cumsum([0] + sizes[:-1])
+    out = np.zeros(len(triangles), bool)
+    for e, factor in enumerate(f):
+        if factor < 0:
+            on_edge = (triangles < ring) & ((triangles - start[e]) % ring <= sizes[e])
+            out |= on_edge.sum(axis=1) >= 2
+    return out
 
 
 def quad_pattern(record) -> tuple[np.ndarray, np.ndarray]:
@@ -234,10 +250,12 @@ def counts(records, domain: str) -> tuple[np.ndarray, np.ndarray]:
     for r, record in enumerate(records):
         m, levels = record_levels(record, domain)
         if m >= 0:
-            out[:, r] = vertex_count(domain, m, levels), 3 * triangle_count(domain, m, levels)
+            triangles = (len(pattern(domain, record)[1]) if min(record[:EDGES[domain]]) < 0  # collapsed edges
+                         else triangle_count(domain, m, levels))
+            out[:, r] = vertex_count(domain, m, levels), 3 * triangles
     return out[0], out[1]
 
 
 __all__ = ["DEFAULT_MAX_LEVEL", "EDGES", "ceil_log2", "edge_levels", "dyadic_factors", "level_histogram", "record_levels", "snap",
            "edge_point", "edge_parameter", "phi", "uniform_triangles", "lattice_layout", "vertex_count",
-           "triangle_count", "pattern", "quad_pattern", "tri_pattern", "counts", "QUAD_SEMI_UNIFORM", "TRI_SEMI_UNIFORM"]
+           "triangle_count", "pattern", "on_collapsed_edges", "quad_pattern", "tri_pattern", "counts", "QUAD_SEMI_UNIFORM", "TRI_SEMI_UNIFORM"]

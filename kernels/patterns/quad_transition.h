@@ -84,21 +84,27 @@ inline uint pattern_grid_index(pattern_grid g, int2 point)
 
 #include "patterns/stitch.h"
 
-inline void grid_cells(__global uint *out, uint *count, uint base, pattern_grid g, int i0, int i1, int j0, int j1)
+/* Cells i0..i1-1 x j0..j1-1 of the grid, two triangles each; a triangle with a side on a
+ * collapsed edge (bit e of collapsed) joins two coincident points and is left out. */
+inline void grid_cells(__global uint *out, uint *count, uint base, pattern_grid g, int collapsed,
+                       int i0, int i1, int j0, int j1)
 {
     for (int j = j0; j < j1; ++j)
         for (int i = i0; i < i1; ++i) {
             uint a = pattern_grid_index(g, (int2)(i, j)), b = pattern_grid_index(g, (int2)(i + 1, j));
             uint c = pattern_grid_index(g, (int2)(i + 1, j + 1)), d = pattern_grid_index(g, (int2)(i, j + 1));
-            put_triangle(out, count, base, a, b, c);
-            put_triangle(out, count, base, a, c, d);
+            if (!((j == 0 && (collapsed & 1)) || (i + 1 == g.core.x && (collapsed & 2))))
+                put_triangle(out, count, base, a, b, c);
+            if (!((j + 1 == g.core.y && (collapsed & 4)) || (i == 0 && (collapsed & 8))))
+                put_triangle(out, count, base, a, c, d);
         }
 }
 
 /* The triangles, in "count" mode (out == 0) or "emit" mode (out != 0): one routine, so the counts
  * of stage 3 and the indices of stage 5 cannot disagree.  Returns the number of triangles;
- * vertex numbers are offset by base. */
-inline uint pattern_primitives(int4 f, __global uint *out, uint base)
+ * vertex numbers are offset by base.  collapsed: bit e for a collapsed edge e (patch_factors),
+ * whose points coincide: no triangle with a side on it. */
+inline uint pattern_primitives(int4 f, int collapsed, __global uint *out, uint base)
 {
     uint count = 0;
     if (f.s0 <= 0)
@@ -106,10 +112,10 @@ inline uint pattern_primitives(int4 f, __global uint *out, uint base)
     pattern_grid g = quad_grid(f);
     int a = g.core.x, b = g.core.y;
     if (g.uniform) {
-        grid_cells(out, &count, base, g, 0, a, 0, b);
+        grid_cells(out, &count, base, g, collapsed, 0, a, 0, b);
         return count;
     }
-    grid_cells(out, &count, base, g, 1, a - 1, 1, b - 1);
+    grid_cells(out, &count, base, g, 0, 1, a - 1, 1, b - 1);
     /* Edge e's inner polyline runs counter-clockwise along the inner grid's boundary, its point k
      * at (k + 1) / along of the edge: segment midpoints at (2k + 3) / (2 along). */
     for (int e = 0; e < 4; ++e) {
@@ -121,7 +127,7 @@ inline uint pattern_primitives(int4 f, __global uint *out, uint base)
         row.last = along - 2;
         row.along = along;
         row.lead = 3;
-        stitch_strip(out, &count, base, g, e, row);
+        stitch_strip(out, &count, base, g, e, row, (collapsed >> e) & 1);
     }
     return count;
 }

@@ -105,16 +105,30 @@ inline uint su_vertex(int4 f, int n, int i, int j)
 
 /* --- the triangles ---------------------------------------------------------------------------- */
 
-inline void su_put(__global uint *out, uint *count, uint base, uint a, uint b, uint c)
+/* Whether local vertex v is a point of ring edge e, its two corners included. */
+inline int su_on_edge(int4 f, int e, uint v)
 {
-    if (a != b && b != c && c != a)  /* collapsed by the snap: dropped */
-        put_triangle(out, count, base, a, b, c);
+    int ring = f.s0 + f.s1 + f.s2 + f.s3;
+    return v < (uint)ring && ((int)v - (int)ring_index(f, e, 0) + ring) % ring <= factor_of(f, e);
+}
+
+/* A triangle is dropped when the snap collapsed it, or when one of its sides lies on a
+ * collapsed edge (patch_factors: that edge's points coincide, issue 9 item 2). */
+inline void su_put(__global uint *out, uint *count, uint base, int4 f, int collapsed, uint a, uint b, uint c)
+{
+    if (a == b || b == c || c == a)  /* collapsed by the snap */
+        return;
+    for (int e = 0; e < PATTERN_EDGES; ++e)
+        if ((collapsed >> e & 1) && su_on_edge(f, e, a) + su_on_edge(f, e, b) + su_on_edge(f, e, c) >= 2)
+            return;
+    put_triangle(out, count, base, a, b, c);
 }
 
 /* The triangles of P^m through phi, collapsed ones dropped, counter-clockwise, in "count" mode
  * (out == 0) or "emit" mode: one routine for stages 3 and 5.  2 n^2 (quad) or n^2 (tri) less
- * one per boundary point snapped away (n - f_e per edge: each is an edge collapse). */
-inline uint pattern_primitives(int4 f, __global uint *out, uint base)
+ * one per boundary point snapped away (n - f_e per edge: each is an edge collapse), less those
+ * on collapsed edges (bit e of collapsed). */
+inline uint pattern_primitives(int4 f, int collapsed, __global uint *out, uint base)
 {
     uint count = 0;
     if (f.s0 <= 0)
@@ -125,15 +139,15 @@ inline uint pattern_primitives(int4 f, __global uint *out, uint base)
         for (int i = 0; i < n; ++i) {
             uint a = su_vertex(f, n, i, j), b = su_vertex(f, n, i + 1, j);
             uint c = su_vertex(f, n, i + 1, j + 1), d = su_vertex(f, n, i, j + 1);
-            su_put(out, &count, base, a, b, c);
-            su_put(out, &count, base, a, c, d);
+            su_put(out, &count, base, f, collapsed, a, b, c);
+            su_put(out, &count, base, f, collapsed, a, c, d);
         }
 #else
         for (int i = 0; i < n - j; ++i) {
             uint a = su_vertex(f, n, i + 1, j), b = su_vertex(f, n, i, j + 1);
-            su_put(out, &count, base, a, b, su_vertex(f, n, i, j));
+            su_put(out, &count, base, f, collapsed, a, b, su_vertex(f, n, i, j));
             if (i + j < n - 1)
-                su_put(out, &count, base, a, su_vertex(f, n, i + 1, j + 1), b);
+                su_put(out, &count, base, f, collapsed, a, su_vertex(f, n, i + 1, j + 1), b);
         }
 #endif
     return count;

@@ -19,15 +19,18 @@ typedef struct {
 } stitch_row;
 
 /* Outer segment o's midpoint (o + 1/2) / f_e comes first when (2o + 1) along <= (2k + lead) f_e,
- * in integers.  Triangles counter-clockwise, as the ring runs. */
-inline void stitch_strip(__global uint *out, uint *count, uint base, pattern_grid g, int e, stitch_row row)
+ * in integers.  Triangles counter-clockwise, as the ring runs.  collapsed: the edge's points
+ * coincide (patch_factors), so the triangles on its segments are left out. */
+inline void stitch_strip(__global uint *out, uint *count, uint base, pattern_grid g, int e, stitch_row row,
+                         int collapsed)
 {
     int4 f = g.f;
     int outer_n = factor_of(f, e), o = 0, k = row.first;
     while (o < outer_n || k < row.last) {
         if (k == row.last || (o < outer_n && (2 * o + 1) * row.along <= (2 * k + row.lead) * outer_n)) {
-            put_triangle(out, count, base, ring_index(f, e, o), ring_index(f, e, o + 1),
-                         pattern_grid_index(g, row.start + k * row.step));
+            if (!collapsed)
+                put_triangle(out, count, base, ring_index(f, e, o), ring_index(f, e, o + 1),
+                             pattern_grid_index(g, row.start + k * row.step));
             ++o;
         } else {
             put_triangle(out, count, base, ring_index(f, e, o),

@@ -80,7 +80,7 @@ inline int2 tri_row_point(int n, int e, int m)
  * (2m + 2) / (2N).  With two transition edges, each row stops where the two rows cross (the
  * paper's modification: the row runs on the extended core grid, less its first, virtual
  * segment).  Factors (1, 1, 1) give the triangle (P1, P2, P3). */
-inline uint pattern_primitives(int4 f, __global uint *out, uint base)
+inline uint pattern_primitives(int4 f, int collapsed, __global uint *out, uint base)
 {
     uint count = 0;
     if (f.s0 <= 0)
@@ -105,7 +105,7 @@ inline uint pattern_primitives(int4 f, __global uint *out, uint base)
             continue;
         int2 start = tri_row_point(n, e, 0);
         stitch_row row = {start, tri_row_point(n, e, 1) - start, t[(e + 2) % 3], n - 1 - t[(e + 1) % 3], n, 2};
-        stitch_strip(out, &count, base, g, e, row);
+        stitch_strip(out, &count, base, g, e, row, (collapsed >> e) & 1);
     }
     return count;
 }

@@ -8,7 +8,8 @@ __kernel void counts(__global const int4 *factors, uint num_patches, uint patch_
     if (get_global_id(0) >= num_patches)
         return;
     uint p = patch_base + (uint)get_global_id(0);
-    int4 f = factors[p];
+    int collapsed;
+    int4 f = patch_factors(factors[p], &collapsed);
     vertex_counts[p] = pattern_vertex_count(f);
-    index_counts[p] = 3 * (ulong)pattern_primitives(f, 0, 0);
+    index_counts[p] = 3 * (ulong)pattern_primitives(f, collapsed, 0, 0);
 }

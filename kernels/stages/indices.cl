@@ -7,6 +7,7 @@ __kernel void indices(__global const int4 *factors, __global const ulong *vertex
 {
     uint p;
     int4 f;
-    if (batch_patch(first_patch, num_patches, factors, &p, &f))
-        pattern_primitives(f, indices + (index_offsets[p] - index_base), (uint)vertex_offsets[p]);
+    int collapsed;
+    if (batch_patch(first_patch, num_patches, factors, &p, &f, &collapsed))
+        pattern_primitives(f, collapsed, indices + (index_offsets[p] - index_base), (uint)vertex_offsets[p]);
 }

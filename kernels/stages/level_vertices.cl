@@ -15,7 +15,8 @@ __kernel void level_vertices(__global const float4 *controls, __global const int
     if (id >= queue_size * size)
         return;
     uint p = queue[id / size];
-    int4 f = factors[p];
+    int collapsed;
+    int4 f = patch_factors(factors[p], &collapsed);
     template_point point = pattern_template_point(f, level, (int)(id % size));
     if (point.vertex < 0)
         return;  /* snapped away */
@@ -28,7 +29,9 @@ __kernel void level_vertices(__global const float4 *controls, __global const int
         edge_param t = pattern_ring_param(f, point.edge, point.k);
         float3 x = pattern_edge_point(point.edge, t);
         kind_eval(&patch, x, 0, &normal);  /* the normal; the position is the edge's */
-        put_vertex(out, at, kind_boundary_point(&patch, point.edge, t), normal, x.xy, p, patch_objects[p]);
+        edge_param corner = {0, t.f};  /* a collapsed edge: every point is its first corner */
+        put_vertex(out, at, kind_boundary_point(&patch, point.edge, (collapsed >> point.edge) & 1 ? corner : t),
+                   normal, x.xy, p, patch_objects[p]);
     } else {
         float3 x = pattern_row_point(f, point.j, point.i);
         kind_eval(&patch, x, &position, &normal);

@@ -13,7 +13,8 @@ __kernel void vertices(__global const float4 *controls, __global const int4 *fac
 {
     uint p;
     int4 f;
-    if (!batch_patch(first_patch, num_patches, factors, &p, &f))
+    int collapsed;
+    if (!batch_patch(first_patch, num_patches, factors, &p, &f, &collapsed))
         return;
     vertex_out out = {positions, normals, uv, patch_ids, object_ids};
     int object = patch_objects[p];
@@ -28,7 +29,9 @@ __kernel void vertices(__global const float4 *controls, __global const int4 *fac
             edge_param t = pattern_ring_param(f, e, k);
             float3 x = pattern_edge_point(e, t);
             kind_eval(&patch, x, 0, &normal);  /* the normal; the position is the edge's */
-            put_vertex(out, at++, kind_boundary_point(&patch, e, t), normal, x.xy, p, object);
+            edge_param corner = {0, t.f};  /* a collapsed edge: every point is its first corner */
+            put_vertex(out, at++, kind_boundary_point(&patch, e, (collapsed >> e) & 1 ? corner : t), normal, x.xy,
+                       p, object);
         }
 
     int rows = pattern_rows(f);

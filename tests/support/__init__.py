@@ -195,3 +195,16 @@ def split_some_vertices(rng: np.random.Generator, mesh: trimesh.Trimesh, fractio
         new_normals.append(n / np.linalg.norm(n))
         faces[f, c] = len(new_vertices) - 1
     return trimesh.Trimesh(np.array(new_vertices), faces, vertex_normals=np.array(new_normals), process=False)
+
+
+def translated_scene(path, offset: float):
+    """A scene file's Bézier patches moved by (offset, offset, offset), and its bounding-box
+    diagonal (the same at any offset)."""
+    from cltess.formats import load_scene
+
+    base = load_scene(path)
+    points = base.patches[..., :3] / base.patches[..., 3:]
+    patches = base.patches.copy()
+    patches[..., :3] = (points + offset) * patches[..., 3:]
+    return (Scene(patches, base.object_ids, name=f"{Path(path).name} + {offset:g}"),
+            float(np.linalg.norm(np.ptp(points.reshape(-1, 3), axis=0))))

@@ -22,12 +22,14 @@ from ...kinds import KINDS
 from ...tessellation import Tessellation
 from .tessellator import WORK_GROUP, Plan, Tessellator, _span_ms
 
-#: m = log2 of the patch's largest factor (its records are 2^p_e), -1 when culled.
+#: m = log2 of the patch's largest factor (its records are 2^p_e; a collapsed edge's stored
+#: negated, common.h patch_factors), -1 when culled.
 LEVEL_PREAMBLE = """
 inline int patch_level(__global const int *factors, uint p)
 {
-    int n = max(max(factors[4 * p], factors[4 * p + 1]), max(factors[4 * p + 2], factors[4 * p + 3]));
-    return factors[4 * p] > 0 ? 31 - (int)clz(n) : -1;
+    int4 f = as_int4(abs((int4)(factors[4 * p], factors[4 * p + 1], factors[4 * p + 2], factors[4 * p + 3])));
+    int n = max(max(f.s0, f.s1), max(f.s2, f.s3));
+    return f.s0 > 0 ? 31 - (int)clz(n) : -1;
 }
 """
 
@@ -121,7 +123,7 @@ def emit_by_level(tessellator: Tessellator, plan: Plan) -> Tessellation:
     stage_ms["total_wall"] = (time.perf_counter() - started) * 1e3
     levels = [histogram.get(level, 0) for level in range(max(histogram, default=-1) + 1)]
     stats = dict(plan.stats, first_patch=0, last_patch=plan.num_patches, level_queues=levels)
-    return Tessellation(triangles=triangles.get(), factors=plan.host_factors(), stage_ms=stage_ms, stats=stats,
+    return Tessellation(triangles=triangles.get(), factors=np.abs(plan.host_factors()), stage_ms=stage_ms, stats=stats,
                         **{k: a.get() for k, a in vertices.items()})
 
 

@@ -28,6 +28,7 @@ STAGE_AXES = {
     "indices": ("pattern",),
     # stage 4 by level (levels.py), for a pattern with a template: built when it is asked for
     "level_vertices": ("kind", "pattern"),
+    "verify": ("kind",),  # on request only (Tessellator.verify), so not in STAGES
 }
 
 
@@ -61,6 +62,15 @@ def program_text(stage: str, headers: tuple, defines: dict) -> tuple[str, list[s
     return source, options
 
 
+def correctly_rounded_division(device: cl.Device) -> list[str]:
+    """``-cl-fp32-correctly-rounded-divide-sqrt`` where the device offers it: a corner's position
+    ``h / w`` must be the float32 point that the host made it project to exactly
+    (``cltess.scene.exact_corners``: a sphere's pole is one position, issue 9 item 2).  OpenCL
+    otherwise allows 2.5 ulp for a division."""
+    config = getattr(device, "single_fp_config", 0)
+    return ["-cl-fp32-correctly-rounded-divide-sqrt"] if config & cl.device_fp_config.CORRECTLY_ROUNDED_DIVIDE_SQRT else []
+
+
 class Programs:
     """The built programs of one context, each built once per composition (pyopencl also
     caches the binaries on disk)."""
@@ -90,6 +100,7 @@ class Programs:
 
     def build(self, stage: str, headers: tuple, defines: dict) -> cl.Program:
         source, options = program_text(stage, headers, defines)
+        options += correctly_rounded_division(self.context.devices[0])
         try:
             return cl.Program(self.context, source).build(options=options)
         except cl.RuntimeError as error:  # the build log is in the message

@@ -39,6 +39,8 @@ from ...tessellation import BYTES_PER_INDEX, BYTES_PER_VERTEX, VERTEX_RECORD, Te
 from .programs import Programs
 
 WORK_GROUP = 64  # global sizes are rounded up to this; kernels guard their index
+VERIFY_ORDER = 6  # Tessellator.verify: 28 points per triangle, corners and edges included
+VERIFY_MAX_TRIANGLES = 4_000_000  # above this, every k-th triangle is verified
 
 
 @dataclass
@@ -199,8 +201,62 @@ class Tessellator:
         stage_ms = {stage: _span_ms(evs) for stage, evs in events.items() if evs}
         stage_ms["total_wall"] = (time.perf_counter() - plan.started) * 1e3
         stats = dict(plan.stats, first_patch=first, last_patch=last)
-        return Tessellation(triangles=triangles.get(), factors=plan.host_factors()[first:last],
+        return Tessellation(triangles=triangles.get(), factors=np.abs(plan.host_factors()[first:last]),
                             stage_ms=stage_ms, stats=stats, **{k: a.get() for k, a in vertices.items()})
+
+    # --- stage 6 on request: the error, measured (issue 9 item 9) ---------------------------------
+
+    def verify(self, scene: Scene, plan: "Plan", tess: Tessellation, order: int = VERIFY_ORDER,
+               max_triangles: int = VERIFY_MAX_TRIANGLES) -> dict:
+        """Measure on the device the worst |S(u,v) - mesh(u,v)| / tolerance of ``tess`` (the
+        output of ``emit(plan, ...)`` for ``scene``, one batch or all), at the barycentric points
+        of order ``order`` of every triangle (``stages/verify.cl``; float64 host mirror:
+        ``cltess.bound.worst_bound_ratio``).  Above ``max_triangles`` triangles, every k-th is
+        measured (k = "verify_stride" > 1: triangles k, 2k, ... of the whole mesh, so batches
+        sample as the single pass does).  Returns the stats: "verify_ratio" (the worst ratio),
+        "verify_patch" and "verify_triangle" (where: scene patch number, triangle number in the
+        whole mesh), "verify_triangles" (how many were measured), "verify_stride",
+        "verify_order", "verify_ms" (device time).  ``combine_verified`` merges batches'."""
+        from ...bound import scene_tolerances
+
+        request = plan.request
+        pixels = request.tolerance.pixels if isinstance(request.tolerance, ScreenSpace) else None
+        eps = request.tolerance.eps if isinstance(request.tolerance, ObjectSpace) else None
+        first, last = tess.stats.get("first_patch", 0), tess.stats.get("last_patch", plan.num_patches)
+        vertex_base, index_base = plan.vertex_range(first, last)[0], plan.index_range(first, last)[0]
+        stride = max(1, -(-(plan.num_indices // 3) // max_triangles)) if max_triangles else 1
+        triangle_base = index_base // 3  # tess's triangle 0 in the whole mesh
+        tolerances = cl_array.to_device(self.queue, scene_tolerances(scene, eps, pixels, request.sharp_edges)
+                                        .astype(np.float32))
+        positions, uv, patch_ids = (cl_array.to_device(self.queue, np.ascontiguousarray(a))
+                                    for a in (tess.positions, tess.uv, tess.patch_ids))
+        triangles = cl_array.to_device(self.queue, (tess.triangles - np.uint32(vertex_base)).astype(np.uint32))
+        worst = {"verify_ratio": 0.0, "verify_patch": -1, "verify_triangle": -1}
+        measured, events = 0, []
+        for part in plan.parts:
+            lo, hi = max(first, part.base), min(last, part.base + part.count)
+            if lo >= hi:
+                continue
+            start, stop = (i // 3 for i in plan.index_range(lo, hi))
+            start = -(-start // stride) * stride - triangle_base  # the whole mesh's triangles k * stride
+            stop -= triangle_base
+            samples = max(0, -(-(stop - start) // stride))
+            if not samples:
+                continue
+            ratios = cl_array.empty(self.queue, samples, np.float32)
+            events.append(self.programs.kernel("verify", kind=part.kind)(
+                self.queue, _global_size(samples), None, part.data["controls"].data, positions.data,
+                uv.data, patch_ids.data, triangles.data, np.uint64(start), np.uint32(stride),
+                np.uint32(samples), np.uint32(part.base), np.int32(order), tolerances.data, ratios.data))
+            host = ratios.get()
+            at = int(host.argmax())
+            if host[at] > worst["verify_ratio"] or worst["verify_triangle"] < 0:
+                triangle = start + at * stride
+                worst = {"verify_ratio": float(host[at]), "verify_triangle": triangle_base + triangle,
+                         "verify_patch": int(tess.patch_ids[tess.triangles[triangle, 0] - vertex_base])}
+            measured += samples
+        return dict(worst, verify_triangles=measured, verify_stride=stride, verify_order=order,
+                    verify_ms=_span_ms(events) if events else 0.0)
 
     # --- stages 4-5 from a plan made elsewhere (issue 17, cltess/batch.py) -----------------------
 
@@ -264,14 +320,17 @@ class Tessellator:
 
     def stage_crack_free(self, factors, groups):
         """Stage 2.  factors (P, 4) int32 and edge groups over its P * 4 entries
-        (cltess.adjacency, or merge_edge_groups for several kinds) -> (P, 4) int32."""
+        (cltess.adjacency, or merge_edge_groups for several kinds) -> (P, 4) int32; the
+        groups' collapsed_edges are stored negated (kernels/common.h, patch_factors)."""
         edges = factors.size
-        group_of, group_start, members = (cl_array.to_device(self.queue, a.astype(np.int32))
-                                          for a in (groups.group_of, groups.group_start, groups.members))
+        collapsed = np.zeros(edges, bool) if groups.collapsed_edges is None else groups.collapsed_edges
+        group_of, group_start, members, collapsed = (
+            cl_array.to_device(self.queue, a.astype(np.int32))
+            for a in (groups.group_of, groups.group_start, groups.members, collapsed))
         final = cl_array.empty(self.queue, factors.shape, np.int32)
         event = self.programs.kernel("crack_free")(
             self.queue, _global_size(edges), None, factors.data, group_of.data, group_start.data,
-            members.data, np.uint32(edges), final.data)
+            members.data, collapsed.data, np.uint32(edges), final.data)
         return final, [event]
 
     def stage_counts(self, factors, kind=BEZIER):
@@ -333,12 +392,23 @@ class Tessellator:
         return triangles, [event]
 
 
+def combine_verified(parts: list[dict]) -> dict:
+    """The verify stats of several batches of one mesh (Tessellator.verify) as one."""
+    parts = [p for p in parts if p]
+    if not parts:
+        return {}
+    worst = max(parts, key=lambda p: p["verify_ratio"])
+    return dict(worst, verify_triangles=sum(p["verify_triangles"] for p in parts),
+                verify_ms=sum(p["verify_ms"] for p in parts))
+
+
 @dataclass
 class Plan:
     """Stages 1-3 done for a whole scene: what stages 4-5 need, on the device.
 
     parts: the kinds' patch ranges and device data (PlanPart); objects: (P,) object ids;
-    factors: (P, 4) final factors; vertex_offsets, index_offsets: (P+1,) exclusive scans with
+    factors: (P, 4) final factors (collapsed edges negated: kernels/common.h patch_factors;
+    ``Tessellation.factors`` are their absolute values); vertex_offsets, index_offsets: (P+1,) exclusive scans with
     the totals last; stats: the scene's counts (see Tessellation.stats); request: what it was
     planned for.
     """
@@ -419,7 +489,7 @@ class HostPlan:
 
     kinds: (kind name, pattern name, base, count) per part; controls: each part's stage-4
     input, (count, 16, 4) float32 (the Bézier patches, or the PN control points stage 1 made);
-    objects (P,) int32; factors (P, 4) int32, final (crack-free); vertex_offsets and
+    objects (P,) int32; factors (P, 4) int32, final (crack-free, collapsed edges negated); vertex_offsets and
     index_offsets (P+1,) uint64 with the totals last; stats as Plan.stats; request: what it
     was planned for.
     """
