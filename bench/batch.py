@@ -17,7 +17,6 @@ Times are wall-clock seconds, the best of ``--repeat`` runs after one untimed wa
 from __future__ import annotations
 
 import argparse
-import hashlib
 import json
 import platform
 import shutil
@@ -30,14 +29,6 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parent.parent
 warnings.filterwarnings("ignore", message="Non-empty compiler output")  # pyopencl, on every build
 SMALL_SCENES = ("teapot.bez", "teacup.bez", "teaspoon.bez", "table.bpt", "sphere.bpt")
-
-
-def digest(path: Path) -> str:
-    sha = hashlib.sha256()
-    with open(path, "rb") as handle:
-        for block in iter(lambda: handle.read(1 << 24), b""):
-            sha.update(block)
-    return sha.hexdigest()
 
 
 def best_of(repeat: int, run) -> tuple[float, object]:
@@ -73,7 +64,8 @@ def many_files(args, work: Path) -> dict:
                    for f in files)
 
     loop_s, triangles = best_of(args.repeat, loop)
-    options = BatchOptions(eps=args.eps, device=args.device)
+    # Per-patch output as read (--no-weld --no-orient), as the loop writes it and as RESULTS.md measured.
+    options = BatchOptions(eps=args.eps, device=args.device, weld=False, orient=False)
     started = time.perf_counter()
     with dask_client(workers=args.workers) as client:
         start_s = time.perf_counter() - started
@@ -93,7 +85,7 @@ def many_files(args, work: Path) -> dict:
 
 
 def huge_scene(args, work: Path) -> dict:
-    from cltess.batch import BatchOptions, dask_client, tessellate_split
+    from cltess.batch import BatchOptions, dask_client, file_sha256, tessellate_split
     from cltess.io import load_scene
     from cltess.pipeline import Tessellator
     from cltess.stream import tessellate_to_file
@@ -104,19 +96,19 @@ def huge_scene(args, work: Path) -> dict:
     single = work / "single.ply"
     single_s, result = best_of(args.repeat, lambda: tessellate_to_file(
         tessellator, scene, single, eps=args.huge_eps, max_factor=args.max_factor))
-    expected = digest(single)
+    expected = file_sha256(single)
     record = {"scene": str(scene_path), "eps": args.huge_eps, "max_factor": args.max_factor,
               "patches": result.stats["patches"], "triangles": result.stats["triangles"],
               "bytes": single.stat().st_size, "single_s": single_s, "single_batches": result.batches,
               "device": tessellator.device.name.strip(), "split": []}
     single.unlink()
-    options = BatchOptions(eps=args.huge_eps, max_factor=args.max_factor, device=args.device)
+    options = BatchOptions(eps=args.huge_eps, max_factor=args.max_factor, device=args.device, orient=False)
     for workers in args.split_workers:
         with dask_client(workers=workers) as client:
             devices = sorted(set(client.run(_device_of, args.device).values()))
             output = work / f"split-{workers}.ply"
             split_s, row = best_of(args.repeat, lambda: tessellate_split(scene_path, output, options, client=client))
-            identical = digest(output) == expected
+            identical = file_sha256(output) == expected
             output.unlink()
         record["split"].append({"workers": workers, "seconds": split_s, "parts": row["parts"],
                                 "identical": identical, "devices": devices})

@@ -152,7 +152,7 @@ def expand_inputs(patterns, exclude=None) -> list[tuple[Path, str]]:
 # --------------------------------------------------------------------------- fingerprints
 
 
-def _sha256(path: Path) -> str:
+def file_sha256(path: Path) -> str:
     digest = hashlib.sha256()
     with open(path, "rb") as handle:
         for block in iter(lambda: handle.read(1 << 20), b""):
@@ -178,7 +178,7 @@ def fingerprint(path: Path) -> list[dict]:
         with contextlib.suppress(OSError):
             stat = file.stat()
             prints.append({"file": str(file), "size": stat.st_size, "mtime_ns": stat.st_mtime_ns,
-                           "sha256": _sha256(file)})
+                           "sha256": file_sha256(file)})
     return prints
 
 
@@ -191,7 +191,7 @@ def _unchanged(prints: list[dict]) -> bool:
             return False
         if (stat.st_size, stat.st_mtime_ns) == (recorded["size"], recorded["mtime_ns"]):
             continue
-        if stat.st_size != recorded["size"] or _sha256(Path(recorded["file"])) != recorded["sha256"]:
+        if stat.st_size != recorded["size"] or file_sha256(Path(recorded["file"])) != recorded["sha256"]:
             return False
     return True
 
@@ -757,5 +757,5 @@ def summarize(rows: list[dict]) -> dict:
 
 
 __all__ = ["BatchOptions", "Progress", "as_table", "dask_client", "default_workers", "device_slots",
-           "expand_inputs", "join_ply_parts", "read_manifest", "split_ranges", "summarize",
+           "expand_inputs", "file_sha256", "join_ply_parts", "read_manifest", "split_ranges", "summarize",
            "tessellate_files", "tessellate_split", "worker_device", "write_manifest"]
