@@ -175,6 +175,9 @@ inline int4 dyadic_factors(int4 f, int max_level, int *saturated)
 #define FLAG_CULLED 2
 #define FLAG_FOLDED 4
 
+/* Primitive-restart marker between triangle strips (cltess/strips.py STRIP_RESTART). */
+#define STRIP_RESTART 0xFFFFFFFFu
+
 /* The factors of a patch as stage 2 stores them: a collapsed edge (its control points one
  * point, e.g. a sphere's pole) negated.  Returns the factors; *collapsed: bit e set for a
  * collapsed edge e (its points all at its first corner; no triangle joins two of them). */

@@ -60,3 +60,11 @@ def test_the_engine_never_imports_the_reference():
             names = [a.name for a in node.names] if isinstance(node, (ast.Import, ast.ImportFrom)) else []
             module = node.module or "" if isinstance(node, ast.ImportFrom) else ""
             assert "reference" not in module.split(".") and not any("reference" in n.split(".") for n in names), path
+
+
+def test_the_strip_restart_marker_is_shared():
+    from cltess.strips import STRIP_RESTART
+
+    common = (kernel_dir() / "common.h").read_text()
+    value = re.search(r"^#define\s+STRIP_RESTART\s+(0x[0-9A-Fa-f]+)u\b", common, re.MULTILINE).group(1)
+    assert int(value, 16) == int(STRIP_RESTART) == 2**32 - 1
