@@ -84,4 +84,39 @@ def worst_bound_ratio(scene, mesh, eps: float | None = None, pixels: float | Non
     return worst
 
 
-__all__ = ["scene_tolerances", "worst_bound_ratio"]
+def tolerances_below_float32(scene, eps: float | None = None, pixels: float | None = None,
+                             sharp_edges: str = "straight") -> str | None:
+    """Why some visible patch's tolerance (as stage 1 computes it: criteria.tolerance.box_tolerances
+    of its control points' box) is below what float32 output coordinates resolve where the patch
+    lies (limits.EPS_FLOAT32_STEPS float32 steps at its largest coordinate), or None.  For
+    ``--pixels`` the tolerance shrinks with the depth, so the scene-wide eps check
+    (limits.eps_below_float32) does not apply; far from the origin a fine pixel tolerance can ask
+    for less than float32 can hold."""
+    from .criteria.tolerance import box_tolerances
+    from .limits import EPS_FLOAT32_STEPS
+
+    boxes = []
+    if scene.num_bezier:
+        points = (scene.patches[..., :3] / scene.patches[..., 3:]).reshape(scene.num_bezier, -1, 3)
+        boxes.append((points.min(axis=1), points.max(axis=1)))
+    if scene.num_triangles:
+        points = _pn_controls(scene, sharp_edges)[:, :10, :3]
+        boxes.append((points.min(axis=1), points.max(axis=1)))
+    if not boxes:
+        return None
+    lo, hi = (np.concatenate(side) for side in zip(*boxes))
+    tolerance, culled = box_tolerances(lo, hi, eps, pixels, scene.camera)
+    largest = np.maximum(np.abs(lo), np.abs(hi)).max(axis=1)
+    floor = EPS_FLOAT32_STEPS * np.spacing(largest.astype(np.float32)).astype(np.float64)
+    below = np.flatnonzero(~culled & (tolerance < floor))
+    if not len(below):
+        return None
+    worst = below[np.argmin(tolerance[below] / floor[below])]
+    asked = f"--pixels {pixels:g}" if pixels is not None else f"eps {eps:g}"
+    return (f"{asked} gives {len(below)} patch(es) a tolerance below {EPS_FLOAT32_STEPS} float32 steps where they "
+            f"lie (patch {worst}: {tolerance[worst]:.3g}, below {floor[worst]:.3g} at its coordinate "
+            f"{largest[worst]:.6g}): the output's float32 coordinates cannot resolve it, so the error bound may "
+            "not hold there; move the scene nearer the origin or raise the tolerance")
+
+
+__all__ = ["scene_tolerances", "tolerances_below_float32", "worst_bound_ratio"]

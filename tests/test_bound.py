@@ -125,3 +125,42 @@ def test_pn_bound_in_screen_space_with_culling(tessellator):
     scene = mesh_scene(genus2(), "genus 2", camera)
     tess = check_pn_bound(tessellator, scene, "genus-2, 0.5 px, camera inside", pixels=0.5, max_factor=256)
     assert 0 < tess.stats["culled"] < scene.num_patches
+
+
+def far_pixel_scene(tmp_path, offset):
+    """The teapot with a camera 10 units away, both moved by (offset, offset, offset)."""
+    import json
+
+    path = tmp_path / f"far{offset:g}.json"
+    path.write_text(json.dumps({
+        "objects": [{"file": str(SCENES / "teapot.bez"),
+                     "transform": [[1, 0, 0, offset], [0, 1, 0, offset], [0, 0, 1, offset], [0, 0, 0, 1]]}],
+        "camera": {"eye": [offset, offset - 10.0, offset + 3.0], "target": [offset, offset, offset + 1.0],
+                   "fov_y_deg": 45.0, "width": 400, "height": 300}}))
+    return path
+
+
+@pytest.mark.parametrize("offset, pixels, warned", [(0.0, 0.2, False), (1e5, 8.0, False), (1e5, 0.2, True)])
+def test_pixels_far_from_the_origin_hold_the_bound_or_warn_before_running(tessellator, capsys, tmp_path,
+                                                                          offset, pixels, warned):
+    """Issue 9: far from the origin a pixel tolerance can ask for less than float32 output can
+    hold; --pixels is checked per patch (cltess.bound.tolerances_below_float32) and warned
+    about before the run, and where it is not warned about the bound holds."""
+    from cltess.cli import main
+    from cltess.io import load_scene as load
+
+    path = far_pixel_scene(tmp_path, offset)
+    out = tmp_path / "m.npz"
+    code = main(["tessellate", str(path), "--pixels", str(pixels), "-q", "-o", str(out)])
+    err = capsys.readouterr().err
+    assert code == 0, err
+    assert ("float32 steps" in err) == warned, err
+    if warned:
+        assert f"cltess: warning: {path}: --pixels {pixels:g} gives" in err
+    scene = load(path)
+    tess = tessellator.tessellate(scene, pixels=pixels, max_factor=4096)
+    eps, _ = reference.patch_tolerances(as_float32(scene.patches), pixels=pixels, camera=scene.camera)
+    ratio = bound_ratio(scene.patches, tess, eps)
+    assert warned or ratio <= 1.0, ratio
+    if warned:
+        assert ratio > 1.0  # the warning is not idle: the bound breaks there

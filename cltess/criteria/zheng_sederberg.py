@@ -47,18 +47,35 @@ def zs_inverse_steps(patch: np.ndarray, eps: float) -> tuple[float, float]:
     second_derivative_hull); Lemma 3's alpha, gamma = rho alpha from the same hull
     (diagonal_majorant), rho = M_vv / M_uu.  Of the two step pairs the one with the larger
     du*dv is taken.  Equal weights: the polynomial Zheng-Sederberg bound, unchanged (Lemma 1 with
-    second_derivative_bounds).
+    second_derivative_bounds).  In two parts: zs_constants (the patch alone) and zs_constant_steps.
     """
+    return zs_constant_steps(zs_constants(patch), eps)
+
+
+def zs_constants(patch: np.ndarray) -> tuple[float, float, float, float]:
+    """(M_uu, M_uv, M_vv, alpha) of one (4, 4, 4) patch: the part of zs_inverse_steps that
+    depends on the patch alone (mirror of kernels/criteria/zs.h, zs_constants, which the device
+    runs once per scene: kernels/stages/constants.cl).  Rational: the M's from
+    second_derivative_hull, alpha = diagonal_majorant(hull, M_vv / M_uu) (0 where M_uu or M_vv
+    is 0).  Equal weights: second_derivative_bounds and alpha = 0 (no Lemma 3)."""
     w = patch[..., 3]
     if (w == w[0, 0]).all():
-        du, dv = zs_steps(*second_derivative_bounds(patch), 8 * eps)
-        return 1 / du, 1 / dv
+        return (*second_derivative_bounds(patch), 0.0)
     hull = second_derivative_hull(patch)
-    m_uu, m_uv, m_vv = np.linalg.norm(hull, axis=-1).max(axis=0)
+    m_uu, m_uv, m_vv = (float(m) for m in np.linalg.norm(hull, axis=-1).max(axis=0))
+    alpha = diagonal_majorant(hull, m_vv / m_uu) if m_uu > 0 and m_vv > 0 else 0.0
+    return m_uu, m_uv, m_vv, alpha
+
+
+def zs_constant_steps(constants, eps: float) -> tuple[float, float]:
+    """(1/du, 1/dv) from a patch's zs_constants and the tolerance: Lemma 1's steps
+    zs_steps(M_uu, M_uv, M_vv, 8 eps), or, where alpha > 0 and its du*dv is larger, Lemma 3's
+    du = sqrt(4 eps / alpha), dv = sqrt(4 eps / (rho alpha)), rho = M_vv / M_uu, each at most 1
+    (mirror of kernels/criteria/zs.h, zs_constant_steps: what stage 1 evaluates per call)."""
+    m_uu, m_uv, m_vv, alpha = (float(x) for x in constants)
     du, dv = zs_steps(m_uu, m_uv, m_vv, 8 * eps)
-    if m_uu > 0 and m_vv > 0:
+    if alpha > 0:
         rho = m_vv / m_uu
-        alpha = diagonal_majorant(hull, rho)
         du_3, dv_3 = min(math.sqrt(4 * eps / alpha), 1.0), min(math.sqrt(4 * eps / (rho * alpha)), 1.0)
         if du_3 * dv_3 > du * dv:
             du, dv = du_3, dv_3

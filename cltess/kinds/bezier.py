@@ -1,5 +1,7 @@
 """Rational bicubic Bézier patches (docs/design.md section 2): the host side of
-kernels/kinds/bezier.h.  Source = controls = (P, 16, 4) homogeneous control points."""
+kernels/kinds/bezier.h.  Source = controls = (P, 16, 4) homogeneous control points; on the
+device stage 1 reads them as controls and its source is the bound's constants, one float4 per
+patch made once per scene (per_patch_constants; criteria/zheng_sederberg.py, zs_constants)."""
 from __future__ import annotations
 
 import numpy as np
@@ -18,6 +20,7 @@ class BezierKind(PatchKind):
     edges = 4
     header = "kinds/bezier.h"
     pattern = QUAD_TRANSITION
+    per_patch_constants = True
     surface = surface
 
     def count(self, scene):

@@ -95,14 +95,16 @@ inline void convolve_wedge(const float4 a[16], const float4 b[16], float4 out[49
         }
 }
 
-/* The steps' inverses (1/du, 1/dv) for a patch and tolerance eps (criteria/zheng_sederberg.py, zs_inverse_steps,
- * docs/rational-bound.md).  Equal weights: Lemma 1 with 6, 9, 6 times the largest second
- * differences of the points (polynomial Zheng-Sederberg).  Rational: the hull points
+/* The bound's constants of a patch, which depend on the patch alone (criteria/zheng_sederberg.py,
+ * zs_constants; docs/rational-bound.md): (M_uu, M_uv, M_vv, alpha).  Equal weights: Lemma 1's
+ * M's are 6, 9, 6 times the largest second differences of the points (polynomial
+ * Zheng-Sederberg) and alpha = 0 (no Lemma 3).  Rational: the hull points
  * H_k = (N_uu, N_uv, N_vv)_k / W_k of (p_uu, p_uv, p_vv) (Lemma 2: w^3 p_uu = w A_uu - 2 w_u B_u,
  * w^3 p_uv = w A_uv - w_u B_v - w_v B_u, w^3 p_vv likewise, A_ab = w X_ab - w_ab X,
- * B_a = w X_a - w_a X, all (9, 9) Bernstein nets); steps from Lemma 1 with M_ab = max |H_k.ab|,
- * or from Lemma 3 (alpha h_u^2 + gamma h_v^2 majorises every |H_k[h, h]|) when those are larger. */
-inline float2 zs_inverse_steps(const float4 b[16], float eps)
+ * B_a = w X_a - w_a X, all (9, 9) Bernstein nets); M_ab = max |H_k.ab|, and Lemma 3's alpha for
+ * rho = M_vv / M_uu (0 when M_uu or M_vv is 0).  About 8,000 float4 multiply-adds per rational
+ * patch: stage 1 does not call this, kernels/stages/constants.cl does, once per scene. */
+inline float4 zs_constants(const float4 b[16])
 {
     float3 lo = b[0].xyz / b[0].w, hi = lo;
     int equal_weights = 1;
@@ -123,7 +125,7 @@ inline float2 zs_inverse_steps(const float4 b[16], float eps)
             for (int i = 0; i < 3; ++i)
                 m.y = max(m.y, length((b[4 * (j + 1) + i + 1].xyz - b[4 * (j + 1) + i].xyz
                                        - b[4 * j + i + 1].xyz + b[4 * j + i].xyz) * inv_w));
-        return 1.0f / zs_steps(6.0f * m.x, 9.0f * m.y, 6.0f * m.z, 8.0f * eps);
+        return (float4)(6.0f * m.x, 9.0f * m.y, 6.0f * m.z, 0.0f);
     }
 
     float3 centre = 0.5f * (lo + hi);  /* the numerators are translation-invariant: keep X small */
@@ -171,10 +173,10 @@ inline float2 zs_inverse_steps(const float4 b[16], float eps)
         }
         if (which == 0) m.x = worst; else if (which == 1) m.y = worst; else m.z = worst;
     }
-    float2 step = zs_steps(m.x, m.y, m.z, 8.0f * eps);  /* Lemma 1 */
 
+    float alpha = 0.0f;
     if (m.x > 0.0f && m.z > 0.0f) {  /* Lemma 3 (zheng_sederberg.diagonal_majorant), rho = M_vv / M_uu */
-        float rho = m.z / m.x, root_rho = sqrt(rho), alpha = 0.0f;
+        float rho = m.z / m.x, root_rho = sqrt(rho);
         for (int k = 0; k < 100; ++k) {
             float3 p = 0.5f * (hull[0][k].xyz + hull[2][k].xyz / rho);
             float3 q = 0.5f * (hull[0][k].xyz - hull[2][k].xyz / rho);
@@ -183,11 +185,31 @@ inline float2 zs_inverse_steps(const float4 b[16], float eps)
             float s2 = 0.5f * (qq + rr) + sqrt(0.25f * (qq - rr) * (qq - rr) + qr * qr);
             alpha = max(alpha, sqrt(dot(p, p) + 2.0f * sqrt(pq * pq + pr * pr) + s2));
         }
+    }
+    return (float4)(m, alpha);
+}
+
+/* The steps' inverses (1/du, 1/dv) from a patch's constants bound = zs_constants(b) and the
+ * tolerance eps (criteria/zheng_sederberg.py, zs_constant_steps): Lemma 1,
+ * zs_steps(M_uu, M_uv, M_vv, 8 eps), or, where alpha > 0 and its du*dv is larger, Lemma 3 with
+ * rho = M_vv / M_uu: du = sqrt(4 eps / alpha), dv = sqrt(4 eps / (rho alpha)), each at most 1.
+ * The part of the bound stage 1 evaluates per tolerance. */
+inline float2 zs_constant_steps(float4 bound, float eps)
+{
+    float2 step = zs_steps(bound.x, bound.y, bound.z, 8.0f * eps);  /* Lemma 1 */
+    if (bound.w > 0.0f) {  /* Lemma 3 */
+        float rho = bound.z / bound.x, alpha = bound.w;
         float2 diagonal = (float2)(min(sqrt(4.0f * eps / alpha), 1.0f), min(sqrt(4.0f * eps / (rho * alpha)), 1.0f));
         if (diagonal.x * diagonal.y > step.x * step.y)
             step = diagonal;
     }
     return 1.0f / step;
+}
+
+/* The steps' inverses for a patch and tolerance eps in one go (zs_inverse_steps on the host). */
+inline float2 zs_inverse_steps(const float4 b[16], float eps)
+{
+    return zs_constant_steps(zs_constants(b), eps);
 }
 
 #endif

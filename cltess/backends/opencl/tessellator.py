@@ -123,18 +123,19 @@ class Tessellator:
         # Oclgrind's uninitialised-value plugin report the scans' output (tests/test_oclgrind.py).
         for kind in kinds:
             self.programs.compose(kind, request.pattern_for(kind), tolerance)
-        parts, inputs, base = [], [], 0
+        parts, inputs, base, events = [], [], 0, {}
         for kind in kinds:
             count = kind.count(scene)
             host = scene.prepared((kind.name, sharp_edges), lambda: kind.prepare(scene, sharp_edges))
-            parts.append(PlanPart(kind, request.pattern_for(kind), base, count, self.upload(kind, host.source)))
+            parts.append(PlanPart(kind, request.pattern_for(kind), base, count,
+                                  self.upload(kind, host.source, scene, events)))
             inputs.append(host)
             base += count
         count = base
         objects = cl_array.to_device(self.queue, np.concatenate([host.objects for host in inputs]).astype(np.int32))
         factors = cl_array.empty(self.queue, (count, FACTOR_SLOTS), np.int32)
         flags = cl_array.empty(self.queue, count, np.int32)
-        events = {"factors": []}
+        events["factors"] = []
         for part in parts:
             events["factors"] += self.stage_factors_of(part.kind, part.data, tolerance, request.max_factor,
                                                        factors, flags, part.base, part.pattern, request.max_level)
@@ -167,13 +168,38 @@ class Tessellator:
         return Plan(scene.name, count, parts, objects, final, vertex_offsets, index_offsets,
                     num_vertices, num_indices, stats, events, started, request, _host=read_back)
 
-    def upload(self, kind: PatchKind, source: np.ndarray) -> dict:
+    def upload(self, kind: PatchKind, source: np.ndarray, scene: Scene | None = None,
+               events: dict | None = None) -> dict:
         """Device arrays of a kind: "source" (one row per patch) for stage 1, "controls" what
-        stage 4 reads (written by stage 1, or the source itself)."""
+        stage 4 reads (written by stage 1, or the source itself).  A kind with
+        ``per_patch_constants`` has the source as controls and the constants as stage 1's source
+        (``patch_constants``: cached on ``scene`` for this context; its event in
+        ``events["constants"]`` when it ran)."""
         data = {"source": cl_array.to_device(self.queue, np.ascontiguousarray(source, np.float32))}
         shape = kind.controls_shape(len(source))
         data["controls"] = data["source"] if shape is None else cl_array.empty(self.queue, shape, np.float32)
+        if kind.per_patch_constants:
+            data["source"] = self.patch_constants(kind, data["controls"], scene, events)
         return data
+
+    def patch_constants(self, kind: PatchKind, controls, scene: Scene | None = None,
+                        events: dict | None = None) -> cl_array.Array:
+        """(P, 4) float32 on the device: kernels/stages/constants.cl on the kind's controls, the
+        part of its bound that depends on the patch alone.  With a scene, once per scene and
+        context (``Scene.prepared``: again only when the scene's arrays change)."""
+        def make():
+            count = len(controls)
+            out = cl_array.empty(self.queue, (count, 4), np.float32)
+            event = self.programs.kernel("constants", kind=kind)(
+                self.queue, _global_size(count), None, controls.data, np.uint32(count), out.data)
+            if events is not None:
+                events.setdefault("constants", []).append(event)
+            return out
+
+        if scene is None:
+            return make()
+        # The cached array holds this context alive, so its id is not reused while cached.
+        return scene.prepared((kind.name, "constants", id(self.context)), make)
 
     def emit(self, plan: "Plan", first: int, last: int, forward_differencing: bool | None = None) -> Tessellation:
         """Stages 4-5 for patches ``first .. last-1`` of a plan, read back to the host
@@ -290,8 +316,8 @@ class Tessellator:
         count = len(patches)
         factors = cl_array.empty(self.queue, (count, FACTOR_SLOTS), np.int32)
         flags = cl_array.empty(self.queue, count, np.int32)
-        events = self.stage_factors_of(BEZIER, {"source": patches, "controls": patches},
-                                       _tolerance(eps, pixels, camera), max_factor, factors, flags)
+        data = {"source": self.patch_constants(BEZIER, patches), "controls": patches}
+        events = self.stage_factors_of(BEZIER, data, _tolerance(eps, pixels, camera), max_factor, factors, flags)
         return factors, flags, events
 
     def stage_pn_factors(self, triangles, eps, pixels, camera, max_factor):
