@@ -43,6 +43,7 @@ from .io.ply import ply_face_records, ply_header, ply_vertex_records
 from .io.writing import atomic_write
 from .io.meshes import MESH_EXTENSIONS
 from .criteria.base import DEFAULT_MAX_FACTOR
+from .patterns.semi_uniform import DEFAULT_MAX_LEVEL
 
 MANIFEST_NAME = "manifest.json"
 MANIFEST_VERSION = 1
@@ -73,6 +74,9 @@ class BatchOptions:
     weld: bool | None = None  # as tessellate --weld: None welds the mesh formats (MESH_FORMATS)
     orient: bool = True  # as tessellate --orient (cltess.orient)
     verify: bool = False  # measure it on the device (Tessellator.verify): verify_ratio, verify_patch
+    pattern: str | None = None  # as tessellate --pattern: a pattern or family name (Request.pattern)
+    max_level: int = DEFAULT_MAX_LEVEL  # as tessellate --max-level (semi-uniform)
+    emit: str = "per_patch"  # as tessellate --emit (Request.emit)
 
     def __post_init__(self):
         if (self.eps is None) == (self.pixels is None):
@@ -94,11 +98,13 @@ class BatchOptions:
         cltess version: a rerun redoes an input whose key differs."""
         return {"eps": self.eps, "pixels": self.pixels, "max_factor": self.max_factor,
                 "forward_differencing": self.forward_differencing, "sharp_edges": self.sharp_edges,
-                "format": self.format, "weld": self.welded, "orient": self.orient, "cltess": _version()}
+                "format": self.format, "weld": self.welded, "orient": self.orient, "pattern": self.pattern,
+                "max_level": self.max_level, "emit": self.emit, "cltess": _version()}
 
     def tessellation_kwargs(self) -> dict:
         return {"eps": self.eps, "pixels": self.pixels, "max_factor": self.max_factor,
-                "forward_differencing": self.forward_differencing, "sharp_edges": self.sharp_edges}
+                "forward_differencing": self.forward_differencing, "sharp_edges": self.sharp_edges,
+                "pattern": self.pattern, "max_level": self.max_level, "emit": self.emit}
 
 
 def _version() -> str:

@@ -5,12 +5,14 @@
                       [--max-memory SIZE] [--sharp-edges {straight,average,keep}] [--crease-angle DEG]
                       [--no-orient] [--no-weld] [--uv {drop,seam}] [--max-output SIZE]
                       [--preview PNG] [--pattern {transition,semi-uniform}] [--max-level L]
+                      [--emit {per-patch,by-level}]
                       [--check-t-junctions] [--device NAME] [--quiet] -o OUT
     cltess render SCENE (--eps E | --eps P% | --pixels PX) [--size W[xH]] [--color {shade,factor}]
                   [the scene options of tessellate] -o PNG
     cltess bench [SCENES...] [--device NAME] [--repeat N] [--warmup N] [--no-baseline] [--json OUT]
     cltess batch INPUTS... (--eps E | --pixels PX) -o OUTDIR [--format {ply,obj,npz}] [--split N]
-                 [--scheduler ADDRESS] [--workers N] [tessellate's options]
+                 [--scheduler ADDRESS] [--workers N] [tessellate's options, --pattern, --max-level
+                 and --emit among them]
 
 Exit codes: 0 success, 1 OpenCL / device failure, 2 usage or input error, 130 interrupted
 (Ctrl-C), 143 and 129 for SIGTERM and SIGHUP, which are handled like Ctrl-C; batch: 3 when
@@ -136,6 +138,8 @@ def _crease_angle(text: str) -> float:
 
 #: --pattern's choices: the pattern families (cltess.patterns.FAMILIES), as the command line spells them.
 PATTERN_CHOICES = {"transition": "transition", "semi-uniform": "semi_uniform"}
+#: --emit's choices: cltess.request.EMIT_MODES, as the command line spells them.
+EMIT_CHOICES = {"per-patch": "per_patch", "by-level": "by_level"}
 
 
 def _max_level(text: str) -> int:
@@ -225,6 +229,10 @@ def build_parser() -> argparse.ArgumentParser:
     shared.add_argument("--max-level", type=_max_level, default=6, metavar="L",
                         help="semi-uniform: the largest level (edge factor 2^L; default 6); a patch that "
                              "needs more is saturated")
+    shared.add_argument("--emit", choices=tuple(EMIT_CHOICES), default="per-patch",
+                        help="semi-uniform: run stages 4-5 per patch (default), or by level: the patches in one "
+                             "queue per level, each level evaluated from one shared template (Dyken et al. "
+                             "2009, section 4.2; direct evaluation, the same mesh as --no-fd)")
     shared.add_argument("-q", "--quiet", action="store_true",
                         help="print nothing on success, no progress bar (warnings still go to stderr)")
 
@@ -286,6 +294,9 @@ def build_parser() -> argparse.ArgumentParser:
                        help=f"as for tessellate (default {DEFAULT_MAX_FACTOR})")
     batch.add_argument("--sharp-edges", choices=("straight", "average", "keep"), default="straight",
                        help="as for tessellate")
+    batch.add_argument("--pattern", choices=tuple(PATTERN_CHOICES), default="transition", help="as for tessellate")
+    batch.add_argument("--max-level", type=_max_level, default=6, metavar="L", help="as for tessellate (default 6)")
+    batch.add_argument("--emit", choices=tuple(EMIT_CHOICES), default="per-patch", help="as for tessellate")
     batch.add_argument("--device", metavar="NAME",
                        help="OpenCL device of every worker (default: one GPU per worker where there are "
                             "several, else the device tessellate would use)")
@@ -409,9 +420,16 @@ def _refuse_overwriting_an_input(output: Path, scene: str) -> None:
             raise UsageError(f"{output}: is an input of this run ({source}); choose another -o")
 
 
+def _check_emit(args) -> None:
+    """--emit by-level runs the semi-uniform patterns' templates: refuse it for another pattern."""
+    if args.emit == "by-level" and args.pattern != "semi-uniform":
+        raise UsageError("--emit by-level needs --pattern semi-uniform (the levels' templates are that pattern's)")
+
+
 def _prepare_scene(args):
     """Load, orient and check the scene; turn a relative --eps into a distance.  Returns (scene,
     orientation report or None, the tolerance as the summary shows it)."""
+    _check_emit(args)
     from cltess.io import load_scene
     from cltess.limits import eps_below_float32
 
@@ -529,7 +547,8 @@ def cmd_tessellate(args) -> int:
             on_batch=(lambda batch: drawing.add(batch.positions, batch.triangles, normals=batch.normals))
             if drawing else None,
             eps=args.eps, pixels=args.pixels, max_factor=args.max_factor, forward_differencing=not args.no_fd,
-            pattern=PATTERN_CHOICES[args.pattern], max_level=args.max_level, verify=args.verify, **mesh_options)
+            pattern=PATTERN_CHOICES[args.pattern], max_level=args.max_level, emit=EMIT_CHOICES[args.emit],
+            verify=args.verify, **mesh_options)
     if drawing is not None:
         from cltess.render import write_png
 
@@ -576,7 +595,8 @@ def cmd_render(args) -> int:
     tessellator = Tessellator(device=device)
     mesh_options = {"sharp_edges": args.sharp_edges} if scene.meshes else {}
     plan = tessellator.plan(scene, eps=args.eps, pixels=args.pixels, max_factor=args.max_factor,
-                            pattern=PATTERN_CHOICES[args.pattern], max_level=args.max_level, **mesh_options)
+                            pattern=PATTERN_CHOICES[args.pattern], max_level=args.max_level,
+                            emit=EMIT_CHOICES[args.emit], **mesh_options)
     _warn_saturated(int(plan.stats.get("saturated", 0)), args)
     budget = args.max_memory or default_budget(tessellator.device)
     drawing = Rasteriser(view_for(scene, *args.size))
@@ -721,10 +741,13 @@ def cmd_batch(args) -> int:
 
     if args.scheduler and args.workers:
         raise UsageError("--workers sizes the local cluster; it cannot be used with --scheduler")
+    _check_emit(args)
     options = BatchOptions(eps=args.eps, pixels=args.pixels, max_factor=args.max_factor,
                            forward_differencing=not args.no_fd, sharp_edges=args.sharp_edges,
                            format=args.format, device=args.device, max_memory=args.max_memory,
-                           check_bound=args.check_bound, weld=args.weld, orient=args.orient, verify=args.verify)
+                           check_bound=args.check_bound, weld=args.weld, orient=args.orient, verify=args.verify,
+                           pattern=PATTERN_CHOICES[args.pattern], max_level=args.max_level,
+                           emit=EMIT_CHOICES[args.emit])
     try:
         rows = tessellate_files(args.inputs, args.output, options, scheduler=args.scheduler,
                                 workers=args.workers, split=args.split, progress=Progress(enabled=not args.quiet))

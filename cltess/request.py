@@ -17,6 +17,8 @@ from .patterns.semi_uniform import DEFAULT_MAX_LEVEL
 
 #: The largest max_level: 2^level within the kernels' factor limit (cltess.limits.MAX_FACTOR).
 MAX_LEVEL = MAX_FACTOR.bit_length() - 1
+#: Request.emit's values: stages 4-5 per patch, or by level (cltess/backends/opencl/levels.py).
+EMIT_MODES = ("per_patch", "by_level")
 from .scene import Scene
 
 
@@ -34,6 +36,11 @@ class Request:
     max_level:      a dyadic pattern's (semi-uniform) largest edge level: factors are rounded up
                     to 2^ceil(log2 f), at most 2^max_level (beyond it the patch is saturated);
                     other patterns ignore it.
+    emit:           how stages 4-5 run: "per_patch" (one work-item per patch), or "by_level"
+                    (the semi-uniform patterns' patches in one queue per level, each evaluated
+                    from the level's template, Dyken et al. 2009 section 4.2; direct evaluation;
+                    other patterns' patches per patch).  The same mesh either way, bit for bit
+                    (per_patch without forward differencing).
     """
 
     tolerance: ObjectSpace | ScreenSpace
@@ -42,6 +49,7 @@ class Request:
     sharp_edges: str = "straight"
     pattern: str | None = None
     max_level: int = DEFAULT_MAX_LEVEL
+    emit: str = "per_patch"
 
     def __post_init__(self):
         value = self.tolerance.eps if isinstance(self.tolerance, ObjectSpace) else self.tolerance.pixels
@@ -57,6 +65,8 @@ class Request:
         if not (isinstance(self.max_level, numbers.Integral) and not isinstance(self.max_level, bool)
                 and 0 <= self.max_level <= MAX_LEVEL):
             raise ValueError(f"max_level must be an integer in 0..{MAX_LEVEL}, got {self.max_level!r}")
+        if self.emit not in EMIT_MODES:
+            raise ValueError(f"emit must be one of {', '.join(EMIT_MODES)}, got {self.emit!r}")
 
     @classmethod
     def of(cls, eps: float | None = None, pixels: float | None = None, **options) -> "Request":

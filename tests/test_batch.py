@@ -283,6 +283,22 @@ def test_cli_batch_split_writes_what_tessellate_writes(client, capsys, tmp_path)
     assert read_manifest(tmp_path / "out")["rows"][0]["parts"] == 3
 
 
+def test_cli_batch_semi_uniform_by_level_writes_what_tessellate_writes(client, capsys, tmp_path):
+    """batch --pattern semi-uniform --max-level 4 --emit by-level, whole and split, gives
+    tessellate's bytes with the same options (by level = per patch without forward differencing)."""
+    options = ["--pattern", "semi-uniform", "--max-level", "4"]
+    for split in ([], ["--split", "3"]):
+        out = tmp_path / f"out{len(split)}"
+        code, stdout, stderr = run(capsys, "batch", SCENES / "teacup.bez", "--eps", 1e-3, *options, "--emit",
+                                   "by-level", *split, "--no-weld", "-o", out, "--scheduler", client.scheduler.address)
+        assert code == 0, stderr
+        assert "1 done, 0 up to date, 0 failed" in stdout
+        code, _, stderr = run(capsys, "tessellate", SCENES / "teacup.bez", "--eps", 1e-3, *options, "--no-fd",
+                              "--no-weld", "-o", tmp_path / "one.ply", "-q")
+        assert code == 0, stderr
+        assert (out / "teacup.bez.ply").read_bytes() == (tmp_path / "one.ply").read_bytes(), split
+
+
 def test_cli_batch_on_its_own_local_cluster(capsys, inputs, tmp_path):
     before = {child.pid for child in psutil.Process().children(recursive=True)}
     code, stdout, stderr = run(capsys, "batch", inputs / "tea*.bez", "--eps", EPS, "-o", tmp_path / "out",
@@ -308,6 +324,7 @@ def test_cli_batch_on_its_own_local_cluster(capsys, inputs, tmp_path):
     (["{teapot}", "--eps", "0.01", "--check-bound"], "add --no-weld"),
     (["{teapot}", "--eps", "0.01", "--split", "2", "--weld"], "--weld cannot be used with --split"),
     (["{teapot}", "--eps", "0.01", "--pixels", "1"], "not allowed with argument"),
+    (["{teapot}", "--eps", "0.01", "--emit", "by-level"], "--emit by-level needs --pattern semi-uniform"),
 ])
 def test_cli_batch_bad_arguments_exit_2_before_any_work(capsys, tmp_path, monkeypatch, arguments, fragment):
     monkeypatch.chdir(tmp_path)

@@ -74,9 +74,9 @@ class FakeTessellator:
         return self.emit(self.plan(scene, eps, pixels, max_factor), 0, 1, forward_differencing)
 
     # The CLI streams through cltess.stream, which calls plan() once and emit() per batch.
-    def plan(self, scene, eps=None, pixels=None, max_factor=64, pattern=None, max_level=6):
+    def plan(self, scene, eps=None, pixels=None, max_factor=64, pattern=None, max_level=6, emit="per_patch"):
         FakeTessellator.calls.append(dict(scene=scene, eps=eps, pixels=pixels, max_factor=max_factor,
-                                          pattern=pattern, max_level=max_level, device=self.device))
+                                          pattern=pattern, max_level=max_level, emit=emit, device=self.device))
         if isinstance(FakeTessellator.result, BaseException):
             raise FakeTessellator.result
         return FakePlan(FakeTessellator.result)
@@ -199,6 +199,7 @@ def test_named_failing_device_exits_1_with_a_short_error(capsys, monkeypatch, tm
     (["--eps", "1e-3", "--pattern", "uniform"], "--pattern"),
     (["--eps", "1e-3", "--max-level", "15"], "--max-level"),
     (["--eps", "1e-3", "--max-level", "-1"], "--max-level"),
+    (["--eps", "1e-3", "--emit", "queued"], "--emit"),
     ([], "--eps"),
 ])
 def test_bad_arguments_exit_2_before_any_work(capsys, tmp_path, scene_file, fake_pipeline, arguments, fragment):
@@ -209,6 +210,14 @@ def test_bad_arguments_exit_2_before_any_work(capsys, tmp_path, scene_file, fake
     assert "usage:" in err
     assert not out_path.exists()
     assert fake_pipeline.calls == []
+
+
+def test_emit_by_level_needs_the_semi_uniform_pattern(capsys, tmp_path, scene_file, fake_pipeline):
+    out_path = tmp_path / "out.ply"
+    code, _, err = run(capsys, "tessellate", scene_file, "--eps", "1e-3", "--emit", "by-level", "-o", out_path)
+    assert code == 2
+    assert_clean_error(err, "--emit by-level needs --pattern semi-uniform")
+    assert not out_path.exists() and fake_pipeline.calls == []
 
 
 def test_missing_output_option_exits_2(capsys, scene_file, fake_pipeline):
@@ -313,7 +322,7 @@ def test_defaults(capsys, tmp_path, scene_file, fake_pipeline):
     assert code == 0
     (call,) = fake_pipeline.calls
     assert call["max_factor"] == 64 and call["forward_differencing"] is True
-    assert call["pattern"] == "transition" and call["max_level"] == 6
+    assert call["pattern"] == "transition" and call["max_level"] == 6 and call["emit"] == "per_patch"
     assert (tmp_path / "m.npz").exists()
 
 
@@ -377,14 +386,14 @@ def test_tessellate_end_to_end(capsys, tmp_path, scene_file):
     assert summary["wrote"] == str(out_path)
 
 
-@pytest.mark.parametrize("extension", [".ply", ".npz"])
-def test_semi_uniform_end_to_end_with_levels_and_t_junctions(capsys, tmp_path, extension):
+@pytest.mark.parametrize("extension, emit", [(".ply", "per-patch"), (".npz", "per-patch"), (".ply", "by-level")])
+def test_semi_uniform_end_to_end_with_levels_and_t_junctions(capsys, tmp_path, extension, emit):
     """--pattern semi-uniform: the summary's level histogram and T-junction
-    count (0: the pattern snaps each edge to its own level)."""
+    count (0: the pattern snaps each edge to its own level), per patch and by level."""
     out_path = tmp_path / f"teapot{extension}"
     scene = Path(__file__).resolve().parents[1] / "scenes" / "teapot.bez"
     code, out, err = run(capsys, "tessellate", scene, "--eps", "1e-2", "--pattern", "semi-uniform",
-                         "--max-level", "5", "--check-t-junctions", "-o", out_path)
+                         "--max-level", "5", "--check-t-junctions", "--emit", emit, "-o", out_path)
     assert code == 0, err
     summary = dict(line.split(None, 1) for line in out.replace("t junctions", "t_junctions")
                    .replace("patch levels", "patch_levels").splitlines())
@@ -392,6 +401,19 @@ def test_semi_uniform_end_to_end_with_levels_and_t_junctions(capsys, tmp_path, e
     levels = dict(item.split(": ") for item in summary["patch_levels"].split(", "))
     assert len(levels) > 1 and max(int(level) for level in levels) <= 5
     assert sum(int(count) for count in levels.values()) == int(summary["patches"].split()[0])
+
+
+def test_emit_by_level_writes_the_per_patch_file(capsys, tmp_path):
+    """--emit by-level gives the file --no-fd gives, byte for byte (welded and per patch)."""
+    scene = Path(__file__).resolve().parents[1] / "scenes" / "teapot.bez"
+    for weld in ("--weld", "--no-weld"):
+        outputs = []
+        for emit in (["--emit", "by-level"], ["--no-fd"]):
+            outputs.append(tmp_path / f"{emit[-1]}{weld}.ply")
+            code, _, err = run(capsys, "tessellate", scene, "--eps", "3e-3", "--pattern", "semi-uniform", weld,
+                               *emit, "-q", "-o", outputs[-1])
+            assert code == 0, err
+        assert outputs[0].read_bytes() == outputs[1].read_bytes()
 
 
 def test_python_dash_m_runs(tmp_path):

@@ -88,13 +88,31 @@ def test_every_case_up_to_level_5(domain):
 
 @pytest.mark.parametrize("domain", ["quad", "tri"])
 def test_all_edges_at_the_patch_level_is_the_uniform_transition_pattern(domain):
-    """Nothing snaps: vertex for vertex and triangle for triangle today's pattern at 2^m."""
+    """Nothing snaps: vertex for vertex today's pattern at 2^m, and its triangles (the interior
+    ones first, su.emit_order)."""
     transition = {"quad": reference.quad_pattern, "tri": reference.tri_pattern}[domain]
     for m in range(MAX_TESTED_LEVEL + 1):
         record = [1 << m] * su.EDGES[domain] + [0] * (4 - su.EDGES[domain])
         uv, triangles = su.pattern(domain, record)
         uv_t, triangles_t = transition(record)
-        assert np.array_equal(uv, uv_t) and np.array_equal(triangles, triangles_t)
+        order = np.concatenate([np.flatnonzero(su.interior_mask(domain, m)),
+                                np.flatnonzero(~su.interior_mask(domain, m))])
+        assert np.array_equal(uv, uv_t) and np.array_equal(triangles, triangles_t[order])
+
+
+@pytest.mark.parametrize("domain", ["quad", "tri"])
+def test_interior_triangles_come_first_and_are_the_template(domain):
+    """For every case up to level 5 the pattern's first triangles are the level's interior
+    template (past the ring), so stage 5 by level writes them without looking at the edges."""
+    for m, levels in all_cases(domain):
+        points, triangles = su.lattice_layout(domain, m, levels)
+        template = su.interior_template(domain, m).astype(np.int64) + sum(1 << p for p in levels)
+        assert np.array_equal(triangles[:len(template)], template), (m, levels)
+        assert not su.inside(domain, points[triangles[len(template):]], m).all(axis=1).any(), (m, levels)
+    for m in range(MAX_TESTED_LEVEL + 1):  # the vertex template: every lattice point once, row by row
+        points = su.point_template(domain, m)
+        assert len(points) == su.vertex_count(domain, m, [m] * su.EDGES[domain])
+        assert np.array_equal(points[np.lexsort((points[:, 0], points[:, 1]))], points)
 
 
 @pytest.mark.parametrize("domain", ["quad", "tri"])

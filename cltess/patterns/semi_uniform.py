@@ -21,8 +21,11 @@ with a transition pattern is sampled at the same points):
 * Vertex layout: the ring first, edge by edge, ``f_e = 2^p_e`` points each (the edge's start
   corner and its interior p_e-dyadic points), then the interior lattice points row by row
   (rows j = 1.., points i = 1..), as the uniform transition patterns lay them out.  With all
-  p_e = m the pattern equals the transition pattern of factors 2^m, vertex for vertex and
-  triangle for triangle.
+  p_e = m the pattern equals the transition pattern of factors 2^m, vertex for vertex, and has
+  its triangles (in another order).
+* Triangle order (:func:`emit_order`): P^m's interior triangles first (never moved nor dropped
+  by the snap, so at the same places for every patch of a level: the level's template), then
+  the band along the boundary, each in the uniform pattern's order.
 
 Record (the int4 the device reads): the dyadic edge factors ``f_e = 2^p_e`` (0: culled), so that
 the ring is ``f_e`` points per edge as for every pattern, the crack-free max over an edge group
@@ -165,10 +168,70 @@ def uniform_triangles(domain: str, m: int) -> np.ndarray:
     return tris
 
 
+def inside(domain: str, points, m: int) -> np.ndarray:
+    """Which lattice points (..., 2) lie strictly inside the domain (phi keeps them, and no
+    collapsed edge reaches them)."""
+    points, n = np.asarray(points, np.int64), 1 << m
+    i, j = points[..., 0], points[..., 1]
+    return (i > 0) & (j > 0) & ((i < n) & (j < n) if domain == "quad" else (i + j < n))
+
+
+@lru_cache(maxsize=None)
+def interior_mask(domain: str, m: int) -> np.ndarray:
+    """Which triangles of P^m (uniform_triangles) are interior: all three corners inside, so
+    the snap neither moves nor drops them; the others form the band along the boundary."""
+    mask = inside(domain, uniform_triangles(domain, m), m).all(axis=1)
+    mask.flags.writeable = False
+    return mask
+
+
+@lru_cache(maxsize=None)
+def emit_order(domain: str, m: int) -> np.ndarray:
+    """P^m's triangles in the order the pattern emits them (kernels/patterns/semi_uniform.h
+    pattern_primitives): the interior triangles, then the band's, each in uniform_triangles'
+    order.  The interior ones then sit at fixed places whatever the edge levels, so that
+    stage 5 by level writes each from the level's template (interior_template)."""
+    mask = interior_mask(domain, m)
+    tris = uniform_triangles(domain, m)
+    ordered = np.concatenate([tris[mask], tris[~mask]])
+    ordered.flags.writeable = False
+    return ordered
+
+
+def interior_vertex(domain: str, points, m: int) -> np.ndarray:
+    """Local number less the ring's size of interior lattice points (..., 2): rows j = 1..,
+    points i = 1.. (kernels/patterns/semi_uniform.h su_interior_vertex)."""
+    points, n = np.asarray(points, np.int64), 1 << m
+    i, j = points[..., 0], points[..., 1]
+    return (j - 1) * (n - 1) + (i - 1) if domain == "quad" else (j - 1) * (2 * n - 2 - j) // 2 + (i - 1)
+
+
+@lru_cache(maxsize=None)
+def point_template(domain: str, m: int) -> np.ndarray:
+    """Level m's vertex template (stages/level_vertices.cl): the lattice points (i, j) of P^m
+    row by row, (S, 2) int32; the snap and the layout are applied per patch on the device."""
+    n = 1 << m
+    points = [(i, j) for j in range(n + 1) for i in range(n + 1 if domain == "quad" else n + 1 - j)]
+    out = np.array(points, np.int32)
+    out.flags.writeable = False
+    return out
+
+
+@lru_cache(maxsize=None)
+def interior_template(domain: str, m: int) -> np.ndarray:
+    """Level m's triangle template (stages/level_indices.cl level_interior): P^m's interior
+    triangles as local vertex numbers less the ring's size, (T, 3) uint32, in emit order; the
+    same for every patch of the level."""
+    tris = uniform_triangles(domain, m)[interior_mask(domain, m)]
+    out = interior_vertex(domain, tris, m).astype(np.uint32).reshape(-1, 3)
+    out.flags.writeable = False
+    return out
+
+
 def lattice_layout(domain: str, m: int, levels) -> tuple[np.ndarray, np.ndarray]:
     """The pattern P^m_{p_0 p_1 ...}: (points (V, 2) int64 on the 2^m lattice, triangles (T, 3)
-    int64 local indices, counter-clockwise), degenerate triangles dropped.  Layout in the module
-    docstring."""
+    int64 local indices, counter-clockwise, in emit_order), degenerate triangles dropped.  Layout
+    in the module docstring."""
     levels = [int(p) for p in levels]
     if len(levels) != EDGES[domain] or not all(0 <= p <= m for p in levels):
         raise ValueError(f"{domain} levels {levels} must be {EDGES[domain]} values in 0..m = {m}")
@@ -178,7 +241,7 @@ def lattice_layout(domain: str, m: int, levels) -> tuple[np.ndarray, np.ndarray]
     points = np.concatenate(ring + [np.array(rows, np.int64).reshape(-1, 2)])
     number = np.full((n + 1, n + 1), -1, np.int64)  # lattice point -> vertex
     number[points[:, 0], points[:, 1]] = np.arange(len(points))
-    snapped = phi(domain, uniform_triangles(domain, m), m, levels)
+    snapped = phi(domain, emit_order(domain, m), m, levels)
     triangles = number[snapped[..., 0], snapped[..., 1]]
     assert (triangles >= 0).all(), "phi left the vertex set"
     a, b, c = triangles.T
@@ -257,5 +320,6 @@ def counts(records, domain: str) -> tuple[np.ndarray, np.ndarray]:
 
 
 __all__ = ["DEFAULT_MAX_LEVEL", "EDGES", "ceil_log2", "edge_levels", "dyadic_factors", "level_histogram", "record_levels", "snap",
-           "edge_point", "edge_parameter", "phi", "uniform_triangles", "lattice_layout", "vertex_count",
+           "edge_point", "edge_parameter", "phi", "uniform_triangles", "inside", "interior_mask", "emit_order",
+           "interior_vertex", "point_template", "interior_template", "lattice_layout", "vertex_count",
            "triangle_count", "pattern", "on_collapsed_edges", "quad_pattern", "tri_pattern", "counts", "QUAD_SEMI_UNIFORM", "TRI_SEMI_UNIFORM"]

@@ -26,8 +26,9 @@ STAGE_AXES = {
     "counts": ("pattern",),
     "vertices": ("kind", "pattern"),
     "indices": ("pattern",),
-    # stage 4 by level (levels.py), for a pattern with a template: built when it is asked for
+    # stages 4-5 by level (levels.py), for a pattern with a template: built when asked for
     "level_vertices": ("kind", "pattern"),
+    "level_indices": ("pattern",),  # two kernels: level_interior, level_band
     "verify": ("kind",),  # on request only (Tessellator.verify), so not in STAGES
     "constants": ("kind",),  # once per scene for kinds with per_patch_constants (Tessellator.upload)
 }
@@ -80,19 +81,23 @@ class Programs:
 
     def __init__(self, context: cl.Context):
         self.context = context
+        self._programs: dict = {}
         self._kernels: dict = {}
         self.offsets_scan = GenericScanKernel(
             context, np.uint64, arguments="__global const ulong *counts, __global ulong *offsets",
             input_expr="counts[i]", scan_expr="a+b", neutral="0",
             output_statement="offsets[i + 1] = item;")
 
-    def kernel(self, stage: str, **axes) -> cl.Kernel:
-        """The stage's kernel composed for ``axes`` (kind=, pattern=, tolerance=, crack=)."""
+    def kernel(self, stage: str, entry: str | None = None, **axes) -> cl.Kernel:
+        """The stage's kernel composed for ``axes`` (kind=, pattern=, tolerance=, crack=): the
+        one named as the stage, or ``entry`` where its file holds several."""
         headers, defines = composition(stage, **axes)
         key = (stage, headers, tuple(sorted(defines.items())))
-        if key not in self._kernels:
-            self._kernels[key] = getattr(self.build(stage, headers, defines), stage)
-        return self._kernels[key]
+        if key not in self._programs:
+            self._programs[key] = self.build(stage, headers, defines)
+        if (key, entry) not in self._kernels:  # one Kernel object each: pyopencl caches its call set-up
+            self._kernels[key, entry] = getattr(self._programs[key], entry or stage)
+        return self._kernels[key, entry]
 
     def compose(self, kind, pattern, tolerance) -> None:
         """Build (or find) every stage's program for one (kind, pattern, tolerance) now."""

@@ -123,6 +123,9 @@ class Tessellator:
         # Oclgrind's uninitialised-value plugin report the scans' output (tests/test_oclgrind.py).
         for kind in kinds:
             self.programs.compose(kind, request.pattern_for(kind), tolerance)
+            if request.emit == "by_level" and request.pattern_for(kind).dyadic:
+                from .levels import build_level_programs
+                build_level_programs(self, kind, request.pattern_for(kind))
         parts, inputs, base, events = [], [], 0, {}
         for kind in kinds:
             count = kind.count(scene)
@@ -203,7 +206,11 @@ class Tessellator:
 
     def emit(self, plan: "Plan", first: int, last: int, forward_differencing: bool | None = None) -> Tessellation:
         """Stages 4-5 for patches ``first .. last-1`` of a plan, read back to the host
-        (forward_differencing: the plan's request's unless given)."""
+        (forward_differencing: the plan's request's unless given; a request with
+        emit="by_level" runs them by level, levels.emit_by_level, without forward differencing)."""
+        if plan.request.emit == "by_level":  # the semi-uniform parts from per-level templates
+            from .levels import emit_by_level
+            return emit_by_level(self, plan, first, last)
         if forward_differencing is None:
             forward_differencing = plan.request.forward_differencing
         vertex_range = plan.vertex_range(first, last)
