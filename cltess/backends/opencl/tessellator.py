@@ -35,7 +35,7 @@ from ...patterns import PATTERNS, Pattern
 from ...patterns.semi_uniform import DEFAULT_MAX_LEVEL, level_histogram
 from ...request import Request
 from ...scene import Scene
-from ...tessellation import BYTES_PER_INDEX, BYTES_PER_VERTEX, VERTEX_RECORD, Tessellation
+from ...tessellation import BYTES_PER_INDEX, BYTES_PER_VERTEX, VERTEX_RECORD, DeviceOutput, Tessellation
 from .programs import Programs
 
 WORK_GROUP = 64  # global sizes are rounded up to this; kernels guard their index
@@ -175,16 +175,23 @@ class Tessellator:
         data["controls"] = data["source"] if shape is None else cl_array.empty(self.queue, shape, np.float32)
         return data
 
-    def emit(self, plan: "Plan", first: int, last: int, forward_differencing: bool | None = None) -> Tessellation:
-        """Stages 4-5 for patches ``first .. last-1`` of a plan, read back to the host
-        (forward_differencing: the plan's request's unless given)."""
+    def emit(self, plan: "Plan", first: int, last: int, forward_differencing: bool | None = None,
+             on_device: bool = False, out: "OutputBuffers | None" = None) -> Tessellation:
+        """Stages 4-5 for patches ``first .. last-1`` of a plan (forward_differencing: the plan's
+        request's unless given).
+
+        on_device: leave the output on the device (``Tessellation.device``, pyopencl arrays),
+        read back to host arrays only when one is asked for; else it is read back now (on a CPU
+        device by mapping the buffers: no copy).  out: output buffers to write into (grown as
+        needed; a ``Session`` reuses its own), else fresh ones."""
         if forward_differencing is None:
             forward_differencing = plan.request.forward_differencing
         vertex_range = plan.vertex_range(first, last)
         index_range = plan.index_range(first, last)
         events = dict(plan.events) if first == 0 else {}
-        vertices = self._vertex_arrays(vertex_range[1] - vertex_range[0])
-        triangles = cl_array.empty(self.queue, ((index_range[1] - index_range[0]) // 3, 3), np.uint32)
+        buffers = out if out is not None else OutputBuffers(self)
+        arrays = buffers.take(vertex_range[1] - vertex_range[0], (index_range[1] - index_range[0]) // 3)
+        vertices = {name: arrays[name] for name, _, _ in VERTEX_RECORD}
         events["vertices"], events["indices"] = [], []
         for part in plan.parts:
             lo, hi = max(first, part.base), min(last, part.base + part.count)
@@ -196,13 +203,26 @@ class Tessellator:
                 pattern=part.pattern)[1]
             events["indices"] += self.stage_indices(
                 plan.factors, plan.vertex_offsets, plan.index_offsets, index_range, (lo, hi),
-                kind=part.pattern, out=triangles)[1]
+                kind=part.pattern, out=arrays["triangles"])[1]
         self.queue.finish()
         stage_ms = {stage: _span_ms(evs) for stage, evs in events.items() if evs}
-        stage_ms["total_wall"] = (time.perf_counter() - plan.started) * 1e3
+        wall_ms = {"stages": (time.perf_counter() - plan.started) * 1e3}
+        stage_ms["total_wall"] = wall_ms["stages"]  # until the host arrays are there: Tessellation.fetch
         stats = dict(plan.stats, first_patch=first, last_patch=last)
-        return Tessellation(triangles=triangles.get(), factors=np.abs(plan.host_factors()[first:last]),
-                            stage_ms=stage_ms, stats=stats, **{k: a.get() for k, a in vertices.items()})
+        generation = buffers.generation
+
+        def read_back() -> dict:
+            host = buffers.read_back(len(vertices["positions"]), len(arrays["triangles"]))
+            host["factors"] = np.abs(plan.host_factors()[first:last])
+            return host
+
+        device = DeviceOutput(arrays, self.queue, vertex_range[0], read_back,
+                              valid=lambda: buffers.generation == generation)
+        tess = Tessellation.on_device(device, stage_ms, stats, wall_ms)
+        if not on_device:
+            tess.fetch()
+            tess.device = None  # the device buffers go when the caller drops nothing but the host arrays
+        return tess
 
     # --- stage 6 on request: the error, measured (issue 9 item 9) ---------------------------------
 
@@ -400,6 +420,98 @@ def combine_verified(parts: list[dict]) -> dict:
     worst = max(parts, key=lambda p: p["verify_ratio"])
     return dict(worst, verify_triangles=sum(p["verify_triangles"] for p in parts),
                 verify_ms=sum(p["verify_ms"] for p in parts))
+
+
+class OutputBuffers:
+    """The output buffers of stages 4-5 on one device: one per field of the vertex record
+    (``VERTEX_RECORD``) and one of triangles, kept and grown only when an output needs more
+    (by a quarter more than asked, so a slowly growing output does not reallocate every frame).
+
+    How the output reaches host arrays (``read_back``) depends on the device:
+
+    * a CPU device: the buffers are allocated with ``CL_MEM_ALLOC_HOST_PTR`` and *mapped*: the
+      host arrays are the buffers' own memory, no copy;
+    * another device with ``pinned=True`` (a ``Session``): copied into page-locked host buffers
+      (``ALLOC_HOST_PTR``, mapped once and kept), which DMA engines fill at the bus's rate;
+    * otherwise copied into fresh (pageable) NumPy arrays.
+
+    Every ``take`` starts a new generation: a result of an earlier one is stale (its arrays
+    will be overwritten), which ``DeviceOutput.valid`` reports.  Host arrays from a mapping or
+    a pinned buffer are views of memory the next ``take`` reuses too.
+    """
+
+    GROWTH = 1.25
+
+    def __init__(self, tessellator: "Tessellator", pinned: bool = False):
+        self.queue = tessellator.queue
+        self.context = tessellator.context
+        self.mapped = bool(tessellator.device.type & cl.device_type.CPU)
+        self.pinned = pinned and not self.mapped
+        self.generation = 0
+        self._buffers: dict = {}  # name -> (device buffer, capacity in rows)
+        self._staging: dict = {}  # name -> (pinned buffer, its mapped host array)
+        self._maps: list = []
+
+    @staticmethod
+    def _layout():
+        return [(name, np.dtype(dtype), shape) for name, dtype, shape in VERTEX_RECORD] + \
+            [("triangles", np.dtype(np.uint32), (3,))]
+
+    def take(self, num_vertices: int, num_triangles: int) -> dict:
+        """pyopencl arrays of (num_vertices, ...) per vertex field and (num_triangles, 3)
+        triangles, on buffers at least that large; a new generation."""
+        self.generation += 1
+        self._maps.clear()  # a host view (pyopencl memory_map) unmaps when its last user drops it
+        flags = cl.mem_flags.READ_WRITE | (cl.mem_flags.ALLOC_HOST_PTR if self.mapped else 0)
+        arrays = {}
+        for name, dtype, shape in self._layout():
+            rows = num_triangles if name == "triangles" else num_vertices
+            row_bytes = dtype.itemsize * int(np.prod(shape))
+            buffer, capacity = self._buffers.get(name, (None, -1))
+            if rows > capacity:  # the first allocation as asked; growing, a quarter more
+                capacity = rows if buffer is None else int(rows * self.GROWTH)
+                self._buffers.pop(name, None)
+                self._staging.pop(name, None)
+                buffer = cl.Buffer(self.context, flags, max(capacity, 1) * row_bytes)
+                self._buffers[name] = (buffer, capacity)
+            arrays[name] = cl_array.Array(self.queue, (rows, *shape), dtype, data=buffer)
+        return arrays
+
+    def read_back(self, num_vertices: int, num_triangles: int) -> dict:
+        """The current generation's output as host arrays (see the class)."""
+        host, events = {}, []
+        for name, dtype, shape in self._layout():
+            rows = num_triangles if name == "triangles" else num_vertices
+            buffer, capacity = self._buffers[name]
+            if not rows:
+                host[name] = np.zeros((0, *shape), dtype)
+            elif self.mapped:
+                array, event = cl.enqueue_map_buffer(self.queue, buffer, cl.map_flags.READ | cl.map_flags.WRITE, 0,
+                                                     (rows, *shape), dtype, is_blocking=False)
+                self._maps.append(array)
+                host[name] = array
+                events.append(event)
+            else:
+                target = self._pinned(name, dtype, shape, capacity)[:rows] if self.pinned \
+                    else np.empty((rows, *shape), dtype)
+                events.append(cl.enqueue_copy(self.queue, target, buffer, is_blocking=False))
+                host[name] = target
+        cl.wait_for_events(events) if events else None
+        return host
+
+    def _pinned(self, name, dtype, shape, capacity) -> np.ndarray:
+        """The page-locked host array of a field (allocated and mapped once per capacity)."""
+        if name not in self._staging:
+            buffer = cl.Buffer(self.context, cl.mem_flags.READ_WRITE | cl.mem_flags.ALLOC_HOST_PTR,
+                               max(capacity, 1) * dtype.itemsize * int(np.prod(shape)))
+            array, _ = cl.enqueue_map_buffer(self.queue, buffer, cl.map_flags.READ | cl.map_flags.WRITE, 0,
+                                             (max(capacity, 1), *shape), dtype, is_blocking=True)
+            self._staging[name] = (buffer, array)
+        return self._staging[name][1]
+
+    @property
+    def nbytes(self) -> int:
+        return sum(buffer.size for buffer, _ in self._buffers.values())
 
 
 @dataclass
