@@ -115,57 +115,98 @@ class Tessellator:
         """Stages 1-3 for the whole scene: final factors and offsets, left on the device."""
         request = request if request is not None else Request.of(**options)
         request.check(scene)
-        tolerance = request.tolerance_for(scene)
         started = time.perf_counter()
-        sharp_edges = request.sharp_edges
+        self.compose(scene, request)
+        return self.plan_on(self.scene_data(scene, request.sharp_edges), request, started)
+
+    def compose(self, scene: Scene, request: Request) -> None:
+        """Build every program a request needs for a scene.  Every program is built before the
+        plan's first buffer exists: builds in between made Oclgrind's uninitialised-value plugin
+        report the scans' output (tests/test_oclgrind.py)."""
+        tolerance = request.tolerance_for(scene)
+        for kind in KINDS:
+            if kind.count(scene):
+                self.programs.compose(kind, request.pattern_for(kind), tolerance)
+
+    def scene_data(self, scene: Scene, sharp_edges: str = "straight") -> "SceneData":
+        """What stays on the device for a scene whatever the tolerance or camera: every kind's
+        upload (``upload``), the object ids and the edge groups of stage 2.  The host side
+        (adjacency, welding) is cached on the scene (``Scene.prepared``)."""
         kinds = [kind for kind in KINDS if kind.count(scene)]
-        # Every program is built before the plan's first buffer exists: builds in between made
-        # Oclgrind's uninitialised-value plugin report the scans' output (tests/test_oclgrind.py).
-        for kind in kinds:
-            self.programs.compose(kind, request.pattern_for(kind), tolerance)
         parts, inputs, base = [], [], 0
         for kind in kinds:
             count = kind.count(scene)
             host = scene.prepared((kind.name, sharp_edges), lambda: kind.prepare(scene, sharp_edges))
-            parts.append(PlanPart(kind, request.pattern_for(kind), base, count, self.upload(kind, host.source)))
+            parts.append((kind, base, count, self.upload(kind, host.source)))
             inputs.append(host)
             base += count
-        count = base
         objects = cl_array.to_device(self.queue, np.concatenate([host.objects for host in inputs]).astype(np.int32))
-        factors = cl_array.empty(self.queue, (count, FACTOR_SLOTS), np.int32)
-        flags = cl_array.empty(self.queue, count, np.int32)
-        events = {"factors": []}
-        for part in parts:
-            events["factors"] += self.stage_factors_of(part.kind, part.data, tolerance, request.max_factor,
-                                                       factors, flags, part.base, part.pattern, request.max_level)
         groups = scene.prepared(("edge groups", sharp_edges), lambda: merge_edge_groups(
-            [(host.groups, part.kind.edges, part.base) for host, part in zip(inputs, parts)], count, FACTOR_SLOTS))
-        final, events["crack_free"] = self.stage_crack_free(factors, groups)
-        vertex_offsets, index_offsets, events["counts"] = self.stage_counts(
-            final, [(part.pattern, part.base, part.count) for part in parts])
-        num_vertices = int(vertex_offsets[count].get())  # the two read-backs
-        num_indices = int(index_offsets[count].get())
-        check_totals(scene.name, num_vertices)
-        flag_values = flags.get()
+            [(host.groups, kind.edges, b) for host, (kind, b, _, _) in zip(inputs, parts)], base, FACTOR_SLOTS))
         stats = {
-            "patches": count,
-            "culled": int(np.count_nonzero(flag_values & FLAG_CULLED)),
-            "saturated": int(np.count_nonzero(flag_values & FLAG_SATURATED)),
-            "vertices": num_vertices,
-            "triangles": num_indices // 3,
             "shared_edges": sum(host.groups.shared for host in inputs),
             "boundary_edges": sum(host.groups.boundary for host in inputs),
             "nonmanifold_edges": sum(host.groups.nonmanifold for host in inputs),
         }
         for host in inputs:
             stats.update(host.stats)
+        return SceneData(scene, sharp_edges, base, parts, objects, self.upload_groups(groups, base), stats)
+
+    def plan_on(self, data: "SceneData", request: Request, started: float | None = None,
+                scratch: dict | None = None) -> "Plan":
+        """Stages 1-3 on a scene's device data (``scene_data``) for a request (its programs
+        built: ``compose``).  scratch: a dict in which the per-patch arrays (factors, flags,
+        counts, offsets) are kept and reused from call to call (a ``Session``'s), so that a
+        new plan overwrites the last one's; else fresh arrays."""
+        started = time.perf_counter() if started is None else started
+        scene, count = data.scene, data.num_patches
+        tolerance = request.tolerance_for(scene)
+        scratch = {} if scratch is None else scratch
+        parts = [PlanPart(kind, request.pattern_for(kind), base, n, uploaded) for kind, base, n, uploaded in data.parts]
+        if "factors" not in scratch:
+            scratch["factors"] = cl_array.empty(self.queue, (count, FACTOR_SLOTS), np.int32)
+            scratch["flags"] = cl_array.empty(self.queue, count, np.int32)
+        factors, flags = scratch["factors"], scratch["flags"]
+        events = {"factors": []}
+        for part in parts:
+            events["factors"] += self.stage_factors_of(part.kind, part.data, tolerance, request.max_factor,
+                                                       factors, flags, part.base, part.pattern, request.max_level)
+        final, events["crack_free"] = self.stage_crack_free(factors, data.groups, out=scratch.get("final"))
+        scratch["final"] = final
+        vertex_offsets, index_offsets, events["counts"] = self.stage_counts(
+            final, [(part.pattern, part.base, part.count) for part in parts], scratch=scratch)
+        totals = np.zeros(2, np.uint64)  # the two read-backs, and the flags, waited for at once
+        flag_values = np.empty(count, np.int32)
+        cl.wait_for_events([
+            cl.enqueue_copy(self.queue, totals[:1], vertex_offsets.data, src_offset=8 * count, is_blocking=False),
+            cl.enqueue_copy(self.queue, totals[1:], index_offsets.data, src_offset=8 * count, is_blocking=False),
+            cl.enqueue_copy(self.queue, flag_values, flags.data, is_blocking=False)])
+        num_vertices, num_indices = int(totals[0]), int(totals[1])
+        check_totals(scene.name, num_vertices)
+        stats = {
+            "patches": count,
+            "culled": int(np.count_nonzero(flag_values & FLAG_CULLED)),
+            "saturated": int(np.count_nonzero(flag_values & FLAG_SATURATED)),
+            "vertices": num_vertices,
+            "triangles": num_indices // 3,
+            **data.stats,
+        }
         read_back = {}
         if any(part.pattern.dyadic for part in parts):  # the semi-uniform patches' levels
             read_back["factors"] = final.get()
             stats["patch_levels"] = level_histogram(np.concatenate(
                 [read_back["factors"][p.base:p.base + p.count] for p in parts if p.pattern.dyadic]))
-        return Plan(scene.name, count, parts, objects, final, vertex_offsets, index_offsets,
+        return Plan(scene.name, count, parts, data.objects, final, vertex_offsets, index_offsets,
                     num_vertices, num_indices, stats, events, started, request, _host=read_back)
+
+    def upload_groups(self, groups, num_patches: int) -> dict:
+        """Stage 2's edge groups (cltess.crack.adjacency.EdgeGroups over the P * 4 edge slots)
+        as device arrays: group_of, group_start, members, collapsed (int32)."""
+        collapsed = np.zeros(num_patches * FACTOR_SLOTS, bool) if groups.collapsed_edges is None \
+            else groups.collapsed_edges
+        return {name: cl_array.to_device(self.queue, np.ascontiguousarray(a, np.int32)) for name, a in
+                (("group_of", groups.group_of), ("group_start", groups.group_start), ("members", groups.members),
+                 ("collapsed", collapsed))}
 
     def upload(self, kind: PatchKind, source: np.ndarray) -> dict:
         """Device arrays of a kind: "source" (one row per patch) for stage 1, "controls" what
@@ -338,32 +379,37 @@ class Tessellator:
             factors.data, flags.data)
         return [event]
 
-    def stage_crack_free(self, factors, groups):
+    def stage_crack_free(self, factors, groups, out=None):
         """Stage 2.  factors (P, 4) int32 and edge groups over its P * 4 entries
-        (cltess.adjacency, or merge_edge_groups for several kinds) -> (P, 4) int32; the
-        groups' collapsed_edges are stored negated (kernels/common.h, patch_factors)."""
+        (cltess.adjacency, or merge_edge_groups for several kinds; or ``upload_groups`` of them)
+        -> (P, 4) int32 (``out`` when given); the groups' collapsed_edges are stored negated
+        (kernels/common.h, patch_factors)."""
         edges = factors.size
-        collapsed = np.zeros(edges, bool) if groups.collapsed_edges is None else groups.collapsed_edges
-        group_of, group_start, members, collapsed = (
-            cl_array.to_device(self.queue, a.astype(np.int32))
-            for a in (groups.group_of, groups.group_start, groups.members, collapsed))
-        final = cl_array.empty(self.queue, factors.shape, np.int32)
+        if not isinstance(groups, dict):
+            groups = self.upload_groups(groups, len(factors))
+        final = cl_array.empty(self.queue, factors.shape, np.int32) if out is None else out
         event = self.programs.kernel("crack_free")(
-            self.queue, _global_size(edges), None, factors.data, group_of.data, group_start.data,
-            members.data, collapsed.data, np.uint32(edges), final.data)
+            self.queue, _global_size(edges), None, factors.data, groups["group_of"].data,
+            groups["group_start"].data, groups["members"].data, groups["collapsed"].data, np.uint32(edges),
+            final.data)
         return final, [event]
 
-    def stage_counts(self, factors, kind=BEZIER):
+    def stage_counts(self, factors, kind=BEZIER, scratch: dict | None = None):
         """Stage 3.  factors (P, 4) -> vertex and index offsets (P+1,) uint64, [P] = total.
 
         kind: the kind (a PatchKind or its name) or the pattern of every patch, or a list of
-        (kind or pattern, base, count) ranges covering 0..P-1."""
+        (kind or pattern, base, count) ranges covering 0..P-1.  scratch: a dict keeping the
+        count and offset arrays for the next call (``plan_on``)."""
         count = len(factors)
         ranges = [(kind, 0, count)] if not isinstance(kind, (list, tuple)) else kind
-        vertex_counts = cl_array.empty(self.queue, count, np.uint64)
-        index_counts = cl_array.empty(self.queue, count, np.uint64)
-        vertex_offsets = cl_array.zeros(self.queue, count + 1, np.uint64)
-        index_offsets = cl_array.zeros(self.queue, count + 1, np.uint64)
+        scratch = {} if scratch is None else scratch
+        if "vertex_counts" not in scratch:  # the scan writes offsets[1:]; offsets[0] stays 0
+            for name in ("vertex_counts", "index_counts"):
+                scratch[name] = cl_array.empty(self.queue, count, np.uint64)
+            for name in ("vertex_offsets", "index_offsets"):
+                scratch[name] = cl_array.zeros(self.queue, count + 1, np.uint64)
+        vertex_counts, index_counts = scratch["vertex_counts"], scratch["index_counts"]
+        vertex_offsets, index_offsets = scratch["vertex_offsets"], scratch["index_offsets"]
         events = [self.programs.kernel("counts", pattern=_pattern(k))(
             self.queue, _global_size(n), None, factors.data, np.uint32(n), np.uint32(base),
             vertex_counts.data, index_counts.data) for k, base, n in ranges if n]
@@ -461,7 +507,7 @@ class OutputBuffers:
         """pyopencl arrays of (num_vertices, ...) per vertex field and (num_triangles, 3)
         triangles, on buffers at least that large; a new generation."""
         self.generation += 1
-        self._maps.clear()  # a host view (pyopencl memory_map) unmaps when its last user drops it
+        self.unmap()
         flags = cl.mem_flags.READ_WRITE | (cl.mem_flags.ALLOC_HOST_PTR if self.mapped else 0)
         arrays = {}
         for name, dtype, shape in self._layout():
@@ -488,7 +534,7 @@ class OutputBuffers:
             elif self.mapped:
                 array, event = cl.enqueue_map_buffer(self.queue, buffer, cl.map_flags.READ | cl.map_flags.WRITE, 0,
                                                      (rows, *shape), dtype, is_blocking=False)
-                self._maps.append(array)
+                self._maps.append(array.base)  # the pyopencl MemoryMap
                 host[name] = array
                 events.append(event)
             else:
@@ -498,6 +544,14 @@ class OutputBuffers:
                 host[name] = target
         cl.wait_for_events(events) if events else None
         return host
+
+    def unmap(self) -> None:
+        """Unmap the host views of the last generation (before the device writes the buffers
+        again, as OpenCL asks).  On a CPU device the views still show the buffers' memory, which
+        the next generation overwrites; the buffers live as long as a view of them does."""
+        if self._maps:
+            cl.wait_for_events([m.release(self.queue) for m in self._maps])
+            self._maps.clear()
 
     def _pinned(self, name, dtype, shape, capacity) -> np.ndarray:
         """The page-locked host array of a field (allocated and mapped once per capacity)."""
@@ -512,6 +566,22 @@ class OutputBuffers:
     @property
     def nbytes(self) -> int:
         return sum(buffer.size for buffer, _ in self._buffers.values())
+
+
+@dataclass
+class SceneData:
+    """A scene's device data, whatever the tolerance or camera (``Tessellator.scene_data``):
+    parts: (kind, base, count, its device arrays ``upload``) per kind in scene order; objects:
+    (P,) int32 object ids; groups: stage 2's edge groups (``upload_groups``); stats: the
+    scene's edge and mesh counts."""
+
+    scene: Scene
+    sharp_edges: str
+    num_patches: int
+    parts: list
+    objects: cl_array.Array
+    groups: dict
+    stats: dict
 
 
 @dataclass
