@@ -27,11 +27,14 @@ def __getattr__(name):
     if name == "Tessellator":
         from .backends.opencl import Tessellator
         return Tessellator
+    if name == "Session":
+        from .session import Session
+        return Session
     if name == "load_scene":
         from .io import load_scene
         return load_scene
     raise AttributeError(name)
 
 
-__all__ = ["__version__", "Camera", "Request", "Scene", "SceneError", "Tessellation", "Tessellator", "load_scene",
-           "export"]
+__all__ = ["__version__", "Camera", "Request", "Scene", "SceneError", "Tessellation", "Tessellator", "Session",
+           "load_scene", "export"]

@@ -1,7 +1,14 @@
-"""The result of a tessellation run: arrays in, arrays out (shapes in the field docs)."""
+"""The result of a tessellation run: arrays in, arrays out (shapes in the field docs).
+
+A result of the OpenCL backend may hold its output on the device only (``Tessellation.device``,
+a :class:`DeviceOutput`): the host arrays are then read back the first time one is asked for
+(``tess.positions``, ``tess.fetch()``), and ``wall_ms`` says what each wall-clock figure covers.
+"""
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 
@@ -17,6 +24,60 @@ VERTEX_RECORD = (
 #: Bytes of one vertex and of one index in the output.
 BYTES_PER_VERTEX = sum(np.dtype(dtype).itemsize * int(np.prod(shape)) for _, dtype, shape in VERTEX_RECORD)
 BYTES_PER_INDEX = 4
+
+
+#: The Tessellation fields a device-resident result reads back on first use.
+HOST_FIELDS = tuple(name for name, _, _ in VERTEX_RECORD) + ("triangles", "factors")
+
+
+class StaleOutput(RuntimeError):
+    """A session's output buffers were reused by a later frame (cltess.session)."""
+
+
+@dataclass
+class DeviceOutput:
+    """A tessellation's output where the device wrote it, with no read-back.
+
+    arrays: ``pyopencl.array.Array`` per field of the vertex record (``VERTEX_RECORD``: one
+    C-contiguous array per field, structure of arrays, row i = vertex i: positions (V, 3) and
+    normals (V, 3) float32 at a 12-byte stride, uv (V, 2) float32 at 8, patch_ids and
+    object_ids (V,) int32 at 4) and "triangles" (T, 3) uint32 at 12, each starting at byte
+    ``offset`` 0 of its array's ``.data`` buffer (``.base_data`` / ``.offset`` for a view of a
+    larger reused buffer).  Triangle indices are global: vertex i of this batch is number
+    ``vertex_base + i`` (0 for a whole scene).
+    read_back: returns the host arrays (a dict with the same keys); valid: whether the buffers
+    still hold this output (False once a session's next frame reused them).
+    """
+
+    arrays: dict
+    queue: object
+    vertex_base: int = 0
+    read_back: Callable[[], dict] | None = None
+    valid: Callable[[], bool] = lambda: True
+
+    def __getattr__(self, name):
+        arrays = self.__dict__.get("arrays", {})
+        if name in arrays:
+            self.check()
+            return arrays[name]
+        raise AttributeError(name)
+
+    def check(self) -> None:
+        if not self.valid():
+            raise StaleOutput("this output's device buffers were reused by a later Session.tessellate "
+                              "call; fetch() or copy what you need before the next frame")
+
+    @property
+    def num_vertices(self) -> int:
+        return int(self.arrays["positions"].shape[0])
+
+    @property
+    def num_triangles(self) -> int:
+        return int(self.arrays["triangles"].shape[0])
+
+    @property
+    def nbytes(self) -> int:
+        return sum(int(a.nbytes) for a in self.arrays.values())
 
 
 class IndexedMesh:
@@ -46,8 +107,16 @@ class Tessellation(IndexedMesh):
     triangles:  (T, 3) uint32, counter-clockwise seen from the normal side
     factors:    (P, 4) int32, the final (crack-free) edge factors; 0 = culled (PN triangles:
                 (f0, f1, f2, 0))
-    stage_ms:   device milliseconds per stage, from OpenCL profiling events
+    stage_ms:   device milliseconds per stage, from OpenCL profiling events, and "total_wall"
+                (= wall_ms["total"])
     stats:      counts for the summary: patches, culled, saturated, shared/boundary edges...
+    wall_ms:    host wall-clock milliseconds: "stages" from the start of the call until the
+                device stages finished (upload, stages 1-5, the two totals read back),
+                "read_back" copying (or, on a CPU device, mapping) the output to host arrays,
+                "total" both: until the caller holds the host arrays.  A device-resident result
+                (``device``) has no "read_back" until its arrays are fetched, and "total" then
+                is "stages" + "read_back" (the time the caller spent between is not counted).
+    device:     the output on the device (:class:`DeviceOutput`), or None (host arrays only).
     """
 
     positions: np.ndarray
@@ -59,6 +128,49 @@ class Tessellation(IndexedMesh):
     factors: np.ndarray
     stage_ms: dict = field(default_factory=dict)
     stats: dict = field(default_factory=dict)
+    wall_ms: dict = field(default_factory=dict)
+    device: DeviceOutput | None = field(default=None, repr=False, compare=False)
+
+    @classmethod
+    def on_device(cls, device: DeviceOutput, stage_ms: dict, stats: dict, wall_ms: dict) -> "Tessellation":
+        """A result whose host arrays (and factors) are read back from ``device`` when first
+        asked for."""
+        tess = object.__new__(cls)
+        tess.stage_ms, tess.stats, tess.wall_ms, tess.device = stage_ms, stats, wall_ms, device
+        return tess
+
+    def __getattr__(self, name):
+        # Called only for attributes not set: the host arrays of a device-resident result.
+        if name in HOST_FIELDS and self.__dict__.get("device") is not None:
+            self.fetch()
+            return self.__dict__[name]
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
+    @property
+    def on_host(self) -> bool:
+        """Whether the host arrays are there (read back already, or made on the host)."""
+        return all(name in self.__dict__ for name in HOST_FIELDS)
+
+    def fetch(self) -> "Tessellation":
+        """Read the output back to host arrays now (a no-op if they are there); records
+        wall_ms["read_back"] and the total."""
+        if self.on_host:
+            return self
+        self.device.check()
+        started = time.perf_counter()
+        self.__dict__.update(self.device.read_back())
+        self.wall_ms["read_back"] = (time.perf_counter() - started) * 1e3
+        self.wall_ms["total"] = self.wall_ms.get("stages", 0.0) + self.wall_ms["read_back"]
+        self.stage_ms["total_wall"] = self.wall_ms["total"]
+        return self
+
+    @property
+    def num_vertices(self) -> int:
+        return self.device.num_vertices if not self.on_host and self.device is not None else len(self.positions)
+
+    @property
+    def num_triangles(self) -> int:
+        return self.device.num_triangles if not self.on_host and self.device is not None else len(self.triangles)
 
     def welded(self, uv: str = "drop", check_t_junctions: bool = True):
         """One indexed mesh per object, shared boundary vertices merged exactly

@@ -19,8 +19,11 @@ Timing method, per scene: one warm-up run with forward differencing (FD) on and 
 off (these also build the kernels), then ``repeat`` runs of each; every figure is the median
 of those runs, and the spread is (max - min) / median.  Stage times are device milliseconds
 from OpenCL profiling events (``Tessellation.stage_ms``); "end to end" is the pipeline's
-``total_wall``: upload, the five stages, the two total read-backs and the read-back of every
-output array.  The host adjacency (and the rest of a patch kind's host preparation) runs once
+``total_wall`` (= ``wall_ms["total"]``): from the call until the caller holds the host arrays
+(upload, the five stages, the two total read-backs, and the read-back of every output array:
+a copy, or on a CPU device a mapping of the buffers).  ``wall_ms["stages"]`` (until the device
+stages finish) and ``wall_ms["read_back"]`` are recorded beside it as "stages_wall" and
+"read_back".  The host adjacency (and the rest of a patch kind's host preparation) runs once
 per scene and is cached on it (``Scene.prepared``), so the warm-up pays it and the timed runs
 do not; it is timed alone beside them, and so is the NumPy baseline (median of ``repeat`` runs).
 """

@@ -28,7 +28,11 @@ def format_tables(record: dict) -> str:
              f"{record['machine']['cpu']}, {record['machine']['cpus']} CPUs. "
              f"{record['pixels']} px, {record['viewport'][0]}x{record['viewport'][1]}; median of "
              f"{record['repeat']} runs after {record['warmup']} warm-up. Memory-write bandwidth "
-             f"(numpy fill): {bandwidth / 1e9:.2f} GB/s.", ""]
+             f"(numpy fill): {bandwidth / 1e9:.2f} GB/s.", "",
+             "End to end: from the call until the caller holds the output as host arrays (upload, the "
+             "five stages, the totals' and the output's read-back; the host adjacency is cached per scene, "
+             "timed alone). Device stages: OpenCL profiling events only. Read-back ms: the output's copy "
+             "(CPU device: mapping) alone.", ""]
     for kind, title in (("bezier", "Table 1: Bézier scenes"), ("pn", "Table 2: PN-triangle scenes")):
         scenes = [s for s in record["scenes"] if s["kind"] == kind]
         skipped = [s for s in record.get("skipped", []) if SUITE.get(s["key"]) and SUITE[s["key"]].kind == kind]
@@ -39,9 +43,9 @@ def format_tables(record: dict) -> str:
         if scenes:
             unit = "patches" if kind == "bezier" else "base tris"
             lines += [f"| scene | {unit} (paper) | culled | vertices | tris (paper) | indices | "
-                      "end to end ms [min-max] | host adjacency ms (timed alone) | Mtri/s e2e | Mtri/s device | "
+                      "end to end ms [min-max] | of which read-back ms | host adjacency ms (timed alone) | Mtri/s e2e | Mtri/s device | "
                       "peak MiB | NumPy eval ms | NumPy / our vertices stage | % of write BW |",
-                      "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+                      "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
             for s in scenes:
                 st, p, e2e = s["stats"], s["paper"], s["fd"]["total_wall"]
                 numpy_ms = s.get("numpy", {}).get("median")
@@ -51,6 +55,7 @@ def format_tables(record: dict) -> str:
                     f"| {s['title']} | {s['base_primitives']:,} ({p.get('patches', 0):,}) | {st['culled']:,} | "
                     f"{st['vertices']:,} | {st['triangles']:,} ({p.get('tris', 0):,}) | {st['indices']:,} | "
                     f"{_ms(e2e['median'])} [{_ms(e2e['min'])}-{_ms(e2e['max'])}] | "
+                    f"{_ms(s['fd']['read_back']['median']) if 'read_back' in s['fd'] else '-'} | "
                     f"{_ms(s['host_adjacency_ms']['median']) if 'host_adjacency_ms' in s else '-'} | "
                     f"{s['triangles_per_s'] / 1e6:.2f} | {s['triangles_per_s_device'] / 1e6:.2f} | "
                     f"{s['peak_device_bytes'] / 2**20:.1f} | {_ms(numpy_ms) if numpy_ms else '-'} | {ratio} | "

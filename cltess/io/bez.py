@@ -9,13 +9,55 @@ import numpy as np
 
 from ..limits import float32_problem
 from ..scene import Scene
-from .text import (_FLOAT_TOKEN, _INDEX_BLOCK_BAD, _INT_TOKEN, _cartesian_rows, _clamped_int, _floats,
-                   _homogeneous, _Lines)
+from .text import (_FLOAT_TOKEN, _INDEX_BLOCK_BAD, _INT_TOKEN, _byte_set, _cartesian_rows, _clamped_int, _decode,
+                   _floats, _homogeneous, _Lines, _Numbers, _read_bytes)
+
+_INDEX_LINE_BYTES = _byte_set(b"0123456789, \t\n")
 
 def read_bez(path) -> Scene:
     """An indexed ``.bez`` file as a single-object scene (object id 0)."""
-    patches = _parse_bez(_Lines.read(path))
+    data = _read_bytes(path)
+    patches = _fast_bez(data)
+    if patches is None:  # something to report, or unusual: line by line, naming the line
+        patches = _parse_bez(_Lines(str(path), _decode(path, data)))
     return Scene(patches, np.zeros(len(patches), np.int32), None, str(path))
+
+
+def _fast_bez(data: bytes) -> np.ndarray | None:
+    """A well-formed ``.bez`` file's (P, 4, 4, 4) homogeneous patches, parsed by NumPy at once
+    (``text._Numbers``), bitwise what ``_parse_bez`` gives; None for anything ``_parse_bez``
+    would report or that is unusual (it then finds the line and says what is wrong)."""
+    numbers = _Numbers.of(data, commas=True)
+    if numbers is None:
+        return None
+    per_line, commas = numbers.per_line, numbers.commas
+    num = numbers.integer_token(0) if per_line[0] == 1 and commas[0] == 0 else None
+    if not num or len(per_line) < num + 3 or per_line[1 + num] != 1 or commas[1 + num]:
+        return None
+    num_vertices = numbers.integer_token(int(numbers.first[1 + num]))
+    if not num_vertices or len(per_line) != num + 2 + num_vertices:
+        return None
+    index_lines, vertex_lines = slice(1, 1 + num), slice(2 + num, None)
+    if (per_line[index_lines] != 16).any() or (commas[index_lines] != 15).any() \
+            or not numbers.only(_INDEX_LINE_BYTES, 1, 1 + num):
+        return None
+    arity = per_line[vertex_lines]
+    if arity[0] not in (3, 4) or (arity != arity[0]).any() or (commas[vertex_lines] != arity - 1).any():
+        return None
+    values = numbers.values
+    indices = values[numbers.first[1]:numbers.first[1] + 16 * num].astype(np.int64)
+    if ((indices < 1) | (indices > num_vertices)).any():
+        return None
+    start = int(numbers.first[2 + num])
+    vertices = values[start:start + int(arity[0]) * num_vertices].reshape(num_vertices, int(arity[0]))
+    if arity[0] == 3:
+        vertices = np.concatenate([vertices, np.ones((num_vertices, 1))], axis=1)
+    elif (vertices[:, 3] <= 0).any():
+        return None
+    homogeneous = _homogeneous(vertices)
+    if float32_problem(homogeneous):
+        return None
+    return homogeneous[indices - 1].reshape(num, 4, 4, 4)
 
 
 def _parse_bez(lines: _Lines) -> np.ndarray:

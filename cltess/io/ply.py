@@ -3,6 +3,8 @@
 one welded mesh (``write_welded_ply``)."""
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
 from ..tessellation import VERTEX_RECORD, Tessellation
@@ -34,24 +36,48 @@ def ply_header(num_vertices: int, num_faces: int) -> bytes:
     return ("\n".join(lines) + "\n").encode("ascii")
 
 
-def ply_vertex_records(block) -> np.ndarray:
+#: Records built and written per step: small enough to stay in cache and to reuse one buffer
+#: (a fresh 400 MB array costs its page faults; measured 3x slower than a reused 10 MB one).
+CHUNK_RECORDS = 1 << 18
+
+
+def ply_vertex_records(block, out: np.ndarray | None = None) -> np.ndarray:
     """The PLY vertex records (PLY_VERTEX_DTYPE) of a block with positions, normals, uv,
-    patch_ids, object_ids."""
-    arrays = _vertex_arrays(block)
-    records = np.empty(len(arrays.positions), PLY_VERTEX_DTYPE)
+    patch_ids, object_ids (into ``out[:k]`` when given)."""
+    return _vertex_records(_vertex_arrays(block), 0, len(block.positions), out)
+
+
+def _vertex_records(arrays, first: int, last: int, out: np.ndarray | None = None) -> np.ndarray:
+    """Records of vertices first..last-1: the fields copied as columns of one (k, 10) 4-byte
+    view (the record is 8 float32 and 2 int32, all little-endian on this host)."""
+    count = last - first
+    records = np.empty(count, PLY_VERTEX_DTYPE) if out is None else out[:count]
+    if sys.byteorder != "little":  # the fields one by one, swapped to little-endian
+        for name, _, shape in VERTEX_RECORD:
+            values = getattr(arrays, name)[first:last]
+            for k, column in enumerate(PLY_COLUMNS[name]):
+                records[column] = values[:, k] if shape else values
+        return records
+    columns = records.view(np.uint32).reshape(count, PLY_VERTEX_DTYPE.itemsize // 4)
+    column = 0
     for name, _, shape in VERTEX_RECORD:
-        values = getattr(arrays, name)
-        for k, column in enumerate(PLY_COLUMNS[name]):
-            records[column] = values[:, k] if shape else values
+        values = getattr(arrays, name)[first:last].view(np.uint32)
+        width = int(np.prod(shape))
+        columns[:, column:column + width] = values.reshape(count, width)
+        column += width
     return records
 
 
-def ply_face_records(triangles) -> np.ndarray:
-    """The PLY face records (PLY_FACE_DTYPE) of (k, 3) vertex indices."""
+def ply_face_records(triangles, out: np.ndarray | None = None) -> np.ndarray:
+    """The PLY face records (PLY_FACE_DTYPE) of (k, 3) vertex indices (into ``out[:k]``)."""
     faces = np.ascontiguousarray(triangles, dtype=np.uint32)
-    records = np.empty(len(faces), PLY_FACE_DTYPE)
-    records["count"] = 3
-    records["vertex_indices"] = faces
+    records = np.empty(len(faces), PLY_FACE_DTYPE) if out is None else out[:len(faces)]
+    if sys.byteorder != "little":
+        records["count"], records["vertex_indices"] = 3, faces
+        return records
+    raw = records.view(np.uint8).reshape(len(faces), PLY_FACE_DTYPE.itemsize)
+    raw[:, 0] = 3
+    raw[:, 1:] = faces.view(np.uint8).reshape(len(faces), 12)
     return records
 
 
@@ -72,11 +98,18 @@ class PlyWriter(_StreamingWriter):
 
     def write_vertices(self, block) -> None:
         """Append vertices: ``block`` has positions (k,3), normals (k,3), uv (k,2), patch_ids, object_ids (k,)."""
-        self._file.write(ply_vertex_records(self._take_vertices(block)).view(np.uint8))
+        arrays = self._take_vertices(block)
+        out = np.empty(min(len(arrays.positions), CHUNK_RECORDS), PLY_VERTEX_DTYPE)
+        for first in range(0, len(arrays.positions), CHUNK_RECORDS):
+            last = min(first + CHUNK_RECORDS, len(arrays.positions))
+            self._file.write(_vertex_records(arrays, first, last, out).view(np.uint8))
 
     def write_faces(self, triangles) -> None:
         """Append faces: (k, 3) global, 0-based vertex indices."""
-        self._put_faces(ply_face_records(self._take_faces(triangles)).tobytes())
+        faces = self._take_faces(triangles)
+        out = np.empty(min(len(faces), CHUNK_RECORDS), PLY_FACE_DTYPE)
+        for first in range(0, len(faces), CHUNK_RECORDS):
+            self._put_faces(ply_face_records(faces[first:first + CHUNK_RECORDS], out).view(np.uint8))
 
 
 def write_ply(tess: Tessellation, path) -> None:

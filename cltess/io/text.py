@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import re
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -67,13 +68,20 @@ class _Lines:
 
 
 def _read_text(path) -> str:
+    return _decode(path, _read_bytes(path))
+
+
+def _read_bytes(path) -> bytes:
     check_scene_file(path)
     try:
-        data = Path(path).read_bytes()
+        return Path(path).read_bytes()
     except FileNotFoundError:
         raise SceneError(f"{path}: file not found") from None
     except OSError as exc:
         raise SceneError(f"{path}: cannot read: {exc.strerror or exc}") from None
+
+
+def _decode(path, data: bytes) -> str:
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
@@ -136,3 +144,95 @@ def _cartesian_rows(patches: np.ndarray) -> np.ndarray:
     """(..., 4) homogeneous -> (..., 4) Cartesian ``(x, y, z, w)``, -0.0 written as 0.0."""
     w = patches[..., 3:]
     return np.concatenate([patches[..., :3] / w, w], axis=-1) + 0.0
+
+
+# --- the fast path: a whole file of plain decimal numbers parsed by NumPy ---------------------
+
+def _byte_set(chars: bytes) -> np.ndarray:
+    table = np.zeros(256, bool)
+    table[list(chars)] = True
+    return table
+
+
+_NUMBER_FILE_BYTES = _byte_set(b"0123456789eE.+- \t\n")
+_NUMBER_FILE_BYTES_COMMA = _byte_set(b"0123456789eE.+-, \t\n")
+_DIGITS = _byte_set(b"0123456789")
+_COMMA_TO_SPACE = bytes.maketrans(b",", b" ")
+
+
+class _Numbers:
+    """The tokens of a text file of plain decimal numbers, parsed at once (no Python per token):
+
+    values (N,) float64, every token in file order; lengths (N,) its characters; start (N,)
+    its byte offset; per_line (L,) the tokens of each non-blank line and first (L,) the index
+    of a line's first token; commas (L,) the commas of each non-blank line (comma files).
+
+    ``_Numbers.of`` returns None for anything unusual (a byte outside ASCII digits, signs,
+    ``.``, ``e``, ``E``, spaces, tabs, newlines (and commas); a token that is not one number
+    read to its end; a non-finite value): the readers then parse line by line, which
+    finds the first problem and names its line.  Values are correctly rounded, as ``float``.
+    """
+
+    def __init__(self, data, values, start, lengths, per_line, commas):
+        self.data, self.values, self.start, self.lengths = data, values, start, lengths
+        self.per_line, self.commas = per_line, commas
+        self.first = np.concatenate(([0], np.cumsum(per_line)[:-1])).astype(np.int64)
+
+    @staticmethod
+    def of(data: bytes, commas: bool = False) -> "_Numbers | None":
+        if b"\r" in data:  # line ends as _Lines counts them
+            data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
+        chars = np.frombuffer(data, np.uint8)
+        if not len(chars) or not (_NUMBER_FILE_BYTES_COMMA if commas else _NUMBER_FILE_BYTES)[chars].all():
+            return None
+        newline = chars == 10
+        comma = chars == 44
+        gap = (chars == 32) | (chars == 9) | newline | comma
+        gap_before = np.concatenate(([True], gap[:-1]))
+        gap_after = np.concatenate((gap[1:], [True]))
+        start = np.flatnonzero(~gap & gap_before)
+        end = np.flatnonzero(~gap & gap_after)
+        if not len(start):
+            return None
+        # strtod token after token: a token it cannot read to its end leaves a remainder that is
+        # either unreadable (NumPy stops: an error, or a warning made one) or read as one more
+        # number (then there are more values than tokens).  Equal counts and no stop: every
+        # token was one number, read in full.
+        text = data.translate(_COMMA_TO_SPACE) if commas else data
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("error")
+                values = np.fromstring(text, dtype=np.float64, sep=" ")
+        except (ValueError, DeprecationWarning):
+            return None
+        if len(values) != len(start) or not np.isfinite(values).all():
+            return None
+        newlines = np.flatnonzero(newline)
+        line = np.searchsorted(newlines, start)  # physical line (0-based) of each token
+        per_line = np.bincount(line)
+        lines = np.flatnonzero(per_line)
+        if commas:
+            commas_per_line = np.bincount(np.searchsorted(newlines, np.flatnonzero(comma)),
+                                          minlength=len(per_line))[:len(per_line)]
+            if commas_per_line.sum() != np.count_nonzero(comma):  # a comma on a line of no token
+                return None
+            commas_per_line = commas_per_line[lines]
+        else:
+            commas_per_line = None
+        return _Numbers(chars, values, start, end - start + 1, per_line[lines], commas_per_line)
+
+    def integer_token(self, k: int) -> int | None:
+        """Token k as a positive integer if it is plain digits (at most 18), else None."""
+        begin, size = int(self.start[k]), int(self.lengths[k])
+        if size > 18 or not _DIGITS[self.data[begin:begin + size]].all():
+            return None
+        return int(self.values[k])
+
+    def only(self, table: np.ndarray, first_line: int, last_line: int) -> bool:
+        """Whether the characters of non-blank lines first_line .. last_line - 1 are all in table."""
+        if last_line <= first_line:
+            return True
+        begin = int(self.start[self.first[first_line]])
+        end_token = self.first[last_line - 1] + self.per_line[last_line - 1] - 1
+        end = int(self.start[end_token] + self.lengths[end_token])
+        return bool(table[self.data[begin:end]].all())

@@ -192,11 +192,15 @@ def emit_by_level(tessellator: Tessellator, plan: Plan, first: int = 0, last: in
                 triangles.data))
     tessellator.queue.finish()
     stage_ms = {stage: _span_ms(evs) for stage, evs in events.items() if evs}
-    stage_ms["total_wall"] = (time.perf_counter() - (plan.started if first == 0 else started)) * 1e3
+    stages_ms = (time.perf_counter() - (plan.started if first == 0 else started)) * 1e3
     levels = [histogram.get(level, 0) for level in range(max(histogram, default=-1) + 1)]
     stats = dict(plan.stats, first_patch=first, last_patch=last, level_queues=levels)
-    return Tessellation(triangles=triangles.get(), factors=np.abs(plan.host_factors()[first:last]), stage_ms=stage_ms,
-                        stats=stats, **{k: a.get() for k, a in vertices.items()})
+    copied = time.perf_counter()
+    host = dict(triangles=triangles.get(), factors=np.abs(plan.host_factors()[first:last]),
+                **{k: a.get() for k, a in vertices.items()})
+    wall_ms = {"stages": stages_ms, "read_back": (time.perf_counter() - copied) * 1e3}
+    wall_ms["total"] = stage_ms["total_wall"] = stages_ms + wall_ms["read_back"]  # until the host arrays are there
+    return Tessellation(stage_ms=stage_ms, stats=stats, wall_ms=wall_ms, **host)
 
 
 def template_size(pattern, level: int) -> int:

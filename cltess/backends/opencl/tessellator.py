@@ -35,7 +35,7 @@ from ...patterns import PATTERNS, Pattern
 from ...patterns.semi_uniform import DEFAULT_MAX_LEVEL, level_histogram
 from ...request import Request
 from ...scene import Scene
-from ...tessellation import BYTES_PER_INDEX, BYTES_PER_VERTEX, VERTEX_RECORD, Tessellation
+from ...tessellation import BYTES_PER_INDEX, BYTES_PER_VERTEX, VERTEX_RECORD, DeviceOutput, Tessellation
 from .programs import Programs
 
 WORK_GROUP = 64  # global sizes are rounded up to this; kernels guard their index
@@ -115,61 +115,98 @@ class Tessellator:
         """Stages 1-3 for the whole scene: final factors and offsets, left on the device."""
         request = request if request is not None else Request.of(**options)
         request.check(scene)
-        tolerance = request.tolerance_for(scene)
         started = time.perf_counter()
-        sharp_edges = request.sharp_edges
+        self.compose(scene, request)
+        return self.plan_on(self.scene_data(scene, request.sharp_edges), request, started)
+
+    def compose(self, scene: Scene, request: Request) -> None:
+        """Build every program a request needs for a scene.  Every program is built before the
+        plan's first buffer exists: builds in between made Oclgrind's uninitialised-value plugin
+        report the scans' output (tests/test_oclgrind.py)."""
+        tolerance = request.tolerance_for(scene)
+        for kind in KINDS:
+            if kind.count(scene):
+                self.programs.compose(kind, request.pattern_for(kind), tolerance)
+
+    def scene_data(self, scene: Scene, sharp_edges: str = "straight") -> "SceneData":
+        """What stays on the device for a scene whatever the tolerance or camera: every kind's
+        upload (``upload``), the object ids and the edge groups of stage 2.  The host side
+        (adjacency, welding) is cached on the scene (``Scene.prepared``)."""
         kinds = [kind for kind in KINDS if kind.count(scene)]
-        # Every program is built before the plan's first buffer exists: builds in between made
-        # Oclgrind's uninitialised-value plugin report the scans' output (tests/test_oclgrind.py).
-        for kind in kinds:
-            self.programs.compose(kind, request.pattern_for(kind), tolerance)
-            if request.emit == "by_level" and request.pattern_for(kind).dyadic:
-                from .levels import build_level_programs
-                build_level_programs(self, kind, request.pattern_for(kind))
         parts, inputs, base, events = [], [], 0, {}
         for kind in kinds:
             count = kind.count(scene)
             host = scene.prepared((kind.name, sharp_edges), lambda: kind.prepare(scene, sharp_edges))
-            parts.append(PlanPart(kind, request.pattern_for(kind), base, count,
-                                  self.upload(kind, host.source, scene, events)))
+            parts.append((kind, base, count, self.upload(kind, host.source, scene, events)))
             inputs.append(host)
             base += count
-        count = base
         objects = cl_array.to_device(self.queue, np.concatenate([host.objects for host in inputs]).astype(np.int32))
-        factors = cl_array.empty(self.queue, (count, FACTOR_SLOTS), np.int32)
-        flags = cl_array.empty(self.queue, count, np.int32)
-        events["factors"] = []
-        for part in parts:
-            events["factors"] += self.stage_factors_of(part.kind, part.data, tolerance, request.max_factor,
-                                                       factors, flags, part.base, part.pattern, request.max_level)
         groups = scene.prepared(("edge groups", sharp_edges), lambda: merge_edge_groups(
-            [(host.groups, part.kind.edges, part.base) for host, part in zip(inputs, parts)], count, FACTOR_SLOTS))
-        final, events["crack_free"] = self.stage_crack_free(factors, groups)
-        vertex_offsets, index_offsets, events["counts"] = self.stage_counts(
-            final, [(part.pattern, part.base, part.count) for part in parts])
-        num_vertices = int(vertex_offsets[count].get())  # the two read-backs
-        num_indices = int(index_offsets[count].get())
-        check_totals(scene.name, num_vertices)
-        flag_values = flags.get()
+            [(host.groups, kind.edges, b) for host, (kind, b, _, _) in zip(inputs, parts)], base, FACTOR_SLOTS))
         stats = {
-            "patches": count,
-            "culled": int(np.count_nonzero(flag_values & FLAG_CULLED)),
-            "saturated": int(np.count_nonzero(flag_values & FLAG_SATURATED)),
-            "vertices": num_vertices,
-            "triangles": num_indices // 3,
             "shared_edges": sum(host.groups.shared for host in inputs),
             "boundary_edges": sum(host.groups.boundary for host in inputs),
             "nonmanifold_edges": sum(host.groups.nonmanifold for host in inputs),
         }
         for host in inputs:
             stats.update(host.stats)
+        return SceneData(scene, sharp_edges, base, parts, objects, self.upload_groups(groups, base), stats, events)
+
+    def plan_on(self, data: "SceneData", request: Request, started: float | None = None,
+                scratch: dict | None = None) -> "Plan":
+        """Stages 1-3 on a scene's device data (``scene_data``) for a request (its programs
+        built: ``compose``).  scratch: a dict in which the per-patch arrays (factors, flags,
+        counts, offsets) are kept and reused from call to call (a ``Session``'s), so that a
+        new plan overwrites the last one's; else fresh arrays."""
+        started = time.perf_counter() if started is None else started
+        scene, count = data.scene, data.num_patches
+        tolerance = request.tolerance_for(scene)
+        scratch = {} if scratch is None else scratch
+        parts = [PlanPart(kind, request.pattern_for(kind), base, n, uploaded) for kind, base, n, uploaded in data.parts]
+        if "factors" not in scratch:
+            scratch["factors"] = cl_array.empty(self.queue, (count, FACTOR_SLOTS), np.int32)
+            scratch["flags"] = cl_array.empty(self.queue, count, np.int32)
+        factors, flags = scratch["factors"], scratch["flags"]
+        events, data.events = {**data.events, "factors": []}, {}
+        for part in parts:
+            events["factors"] += self.stage_factors_of(part.kind, part.data, tolerance, request.max_factor,
+                                                       factors, flags, part.base, part.pattern, request.max_level)
+        final, events["crack_free"] = self.stage_crack_free(factors, data.groups, out=scratch.get("final"))
+        scratch["final"] = final
+        vertex_offsets, index_offsets, events["counts"] = self.stage_counts(
+            final, [(part.pattern, part.base, part.count) for part in parts], scratch=scratch)
+        totals = np.zeros(2, np.uint64)  # the two read-backs, and the flags, waited for at once
+        flag_values = np.empty(count, np.int32)
+        cl.wait_for_events([
+            cl.enqueue_copy(self.queue, totals[:1], vertex_offsets.data, src_offset=8 * count, is_blocking=False),
+            cl.enqueue_copy(self.queue, totals[1:], index_offsets.data, src_offset=8 * count, is_blocking=False),
+            cl.enqueue_copy(self.queue, flag_values, flags.data, is_blocking=False)])
+        num_vertices, num_indices = int(totals[0]), int(totals[1])
+        check_totals(scene.name, num_vertices)
+        stats = {
+            "patches": count,
+            "culled": int(np.count_nonzero(flag_values & FLAG_CULLED)),
+            "saturated": int(np.count_nonzero(flag_values & FLAG_SATURATED)),
+            "vertices": num_vertices,
+            "triangles": num_indices // 3,
+            **data.stats,
+        }
         read_back = {}
         if any(part.pattern.dyadic for part in parts):  # the semi-uniform patches' levels
             read_back["factors"] = final.get()
             stats["patch_levels"] = level_histogram(np.concatenate(
                 [read_back["factors"][p.base:p.base + p.count] for p in parts if p.pattern.dyadic]))
-        return Plan(scene.name, count, parts, objects, final, vertex_offsets, index_offsets,
+        return Plan(scene.name, count, parts, data.objects, final, vertex_offsets, index_offsets,
                     num_vertices, num_indices, stats, events, started, request, _host=read_back)
+
+    def upload_groups(self, groups, num_patches: int) -> dict:
+        """Stage 2's edge groups (cltess.crack.adjacency.EdgeGroups over the P * 4 edge slots)
+        as device arrays: group_of, group_start, members, collapsed (int32)."""
+        collapsed = np.zeros(num_patches * FACTOR_SLOTS, bool) if groups.collapsed_edges is None \
+            else groups.collapsed_edges
+        return {name: cl_array.to_device(self.queue, np.ascontiguousarray(a, np.int32)) for name, a in
+                (("group_of", groups.group_of), ("group_start", groups.group_start), ("members", groups.members),
+                 ("collapsed", collapsed))}
 
     def upload(self, kind: PatchKind, source: np.ndarray, scene: Scene | None = None,
                events: dict | None = None) -> dict:
@@ -204,10 +241,16 @@ class Tessellator:
         # The cached array holds this context alive, so its id is not reused while cached.
         return scene.prepared((kind.name, "constants", id(self.context)), make)
 
-    def emit(self, plan: "Plan", first: int, last: int, forward_differencing: bool | None = None) -> Tessellation:
-        """Stages 4-5 for patches ``first .. last-1`` of a plan, read back to the host
-        (forward_differencing: the plan's request's unless given; a request with
-        emit="by_level" runs them by level, levels.emit_by_level, without forward differencing)."""
+    def emit(self, plan: "Plan", first: int, last: int, forward_differencing: bool | None = None,
+             on_device: bool = False, out: "OutputBuffers | None" = None) -> Tessellation:
+        """Stages 4-5 for patches ``first .. last-1`` of a plan (forward_differencing: the plan's
+        request's unless given).
+
+        on_device: leave the output on the device (``Tessellation.device``, pyopencl arrays),
+        read back to host arrays only when one is asked for; else it is read back now (on a CPU
+        device by mapping the buffers: no copy).  out: output buffers to write into (grown as
+        needed; a ``Session`` reuses its own), else fresh ones.  A request with emit="by_level"
+        runs them by level (levels.emit_by_level, without forward differencing, read back now)."""
         if plan.request.emit == "by_level":  # the semi-uniform parts from per-level templates
             from .levels import emit_by_level
             return emit_by_level(self, plan, first, last)
@@ -216,8 +259,9 @@ class Tessellator:
         vertex_range = plan.vertex_range(first, last)
         index_range = plan.index_range(first, last)
         events = dict(plan.events) if first == 0 else {}
-        vertices = self._vertex_arrays(vertex_range[1] - vertex_range[0])
-        triangles = cl_array.empty(self.queue, ((index_range[1] - index_range[0]) // 3, 3), np.uint32)
+        buffers = out if out is not None else OutputBuffers(self)
+        arrays = buffers.take(vertex_range[1] - vertex_range[0], (index_range[1] - index_range[0]) // 3)
+        vertices = {name: arrays[name] for name, _, _ in VERTEX_RECORD}
         events["vertices"], events["indices"] = [], []
         for part in plan.parts:
             lo, hi = max(first, part.base), min(last, part.base + part.count)
@@ -229,13 +273,26 @@ class Tessellator:
                 pattern=part.pattern)[1]
             events["indices"] += self.stage_indices(
                 plan.factors, plan.vertex_offsets, plan.index_offsets, index_range, (lo, hi),
-                kind=part.pattern, out=triangles)[1]
+                kind=part.pattern, out=arrays["triangles"])[1]
         self.queue.finish()
         stage_ms = {stage: _span_ms(evs) for stage, evs in events.items() if evs}
-        stage_ms["total_wall"] = (time.perf_counter() - plan.started) * 1e3
+        wall_ms = {"stages": (time.perf_counter() - plan.started) * 1e3}
+        stage_ms["total_wall"] = wall_ms["stages"]  # until the host arrays are there: Tessellation.fetch
         stats = dict(plan.stats, first_patch=first, last_patch=last)
-        return Tessellation(triangles=triangles.get(), factors=np.abs(plan.host_factors()[first:last]),
-                            stage_ms=stage_ms, stats=stats, **{k: a.get() for k, a in vertices.items()})
+        generation = buffers.generation
+
+        def read_back() -> dict:
+            host = buffers.read_back(len(vertices["positions"]), len(arrays["triangles"]))
+            host["factors"] = np.abs(plan.host_factors()[first:last])
+            return host
+
+        device = DeviceOutput(arrays, self.queue, vertex_range[0], read_back,
+                              valid=lambda: buffers.generation == generation)
+        tess = Tessellation.on_device(device, stage_ms, stats, wall_ms)
+        if not on_device:
+            tess.fetch()
+            tess.device = None  # the device buffers go when the caller drops nothing but the host arrays
+        return tess
 
     # --- stage 6 on request: the error, measured (issue 9 item 9) ---------------------------------
 
@@ -351,32 +408,37 @@ class Tessellator:
             factors.data, flags.data)
         return [event]
 
-    def stage_crack_free(self, factors, groups):
+    def stage_crack_free(self, factors, groups, out=None):
         """Stage 2.  factors (P, 4) int32 and edge groups over its P * 4 entries
-        (cltess.adjacency, or merge_edge_groups for several kinds) -> (P, 4) int32; the
-        groups' collapsed_edges are stored negated (kernels/common.h, patch_factors)."""
+        (cltess.adjacency, or merge_edge_groups for several kinds; or ``upload_groups`` of them)
+        -> (P, 4) int32 (``out`` when given); the groups' collapsed_edges are stored negated
+        (kernels/common.h, patch_factors)."""
         edges = factors.size
-        collapsed = np.zeros(edges, bool) if groups.collapsed_edges is None else groups.collapsed_edges
-        group_of, group_start, members, collapsed = (
-            cl_array.to_device(self.queue, a.astype(np.int32))
-            for a in (groups.group_of, groups.group_start, groups.members, collapsed))
-        final = cl_array.empty(self.queue, factors.shape, np.int32)
+        if not isinstance(groups, dict):
+            groups = self.upload_groups(groups, len(factors))
+        final = cl_array.empty(self.queue, factors.shape, np.int32) if out is None else out
         event = self.programs.kernel("crack_free")(
-            self.queue, _global_size(edges), None, factors.data, group_of.data, group_start.data,
-            members.data, collapsed.data, np.uint32(edges), final.data)
+            self.queue, _global_size(edges), None, factors.data, groups["group_of"].data,
+            groups["group_start"].data, groups["members"].data, groups["collapsed"].data, np.uint32(edges),
+            final.data)
         return final, [event]
 
-    def stage_counts(self, factors, kind=BEZIER):
+    def stage_counts(self, factors, kind=BEZIER, scratch: dict | None = None):
         """Stage 3.  factors (P, 4) -> vertex and index offsets (P+1,) uint64, [P] = total.
 
         kind: the kind (a PatchKind or its name) or the pattern of every patch, or a list of
-        (kind or pattern, base, count) ranges covering 0..P-1."""
+        (kind or pattern, base, count) ranges covering 0..P-1.  scratch: a dict keeping the
+        count and offset arrays for the next call (``plan_on``)."""
         count = len(factors)
         ranges = [(kind, 0, count)] if not isinstance(kind, (list, tuple)) else kind
-        vertex_counts = cl_array.empty(self.queue, count, np.uint64)
-        index_counts = cl_array.empty(self.queue, count, np.uint64)
-        vertex_offsets = cl_array.zeros(self.queue, count + 1, np.uint64)
-        index_offsets = cl_array.zeros(self.queue, count + 1, np.uint64)
+        scratch = {} if scratch is None else scratch
+        if "vertex_counts" not in scratch:  # the scan writes offsets[1:]; offsets[0] stays 0
+            for name in ("vertex_counts", "index_counts"):
+                scratch[name] = cl_array.empty(self.queue, count, np.uint64)
+            for name in ("vertex_offsets", "index_offsets"):
+                scratch[name] = cl_array.zeros(self.queue, count + 1, np.uint64)
+        vertex_counts, index_counts = scratch["vertex_counts"], scratch["index_counts"]
+        vertex_offsets, index_offsets = scratch["vertex_offsets"], scratch["index_offsets"]
         events = [self.programs.kernel("counts", pattern=_pattern(k))(
             self.queue, _global_size(n), None, factors.data, np.uint32(n), np.uint32(base),
             vertex_counts.data, index_counts.data) for k, base, n in ranges if n]
@@ -433,6 +495,123 @@ def combine_verified(parts: list[dict]) -> dict:
     worst = max(parts, key=lambda p: p["verify_ratio"])
     return dict(worst, verify_triangles=sum(p["verify_triangles"] for p in parts),
                 verify_ms=sum(p["verify_ms"] for p in parts))
+
+
+class OutputBuffers:
+    """The output buffers of stages 4-5 on one device: one per field of the vertex record
+    (``VERTEX_RECORD``) and one of triangles, kept and grown only when an output needs more
+    (by a quarter more than asked, so a slowly growing output does not reallocate every frame).
+
+    How the output reaches host arrays (``read_back``) depends on the device:
+
+    * a CPU device: the buffers are allocated with ``CL_MEM_ALLOC_HOST_PTR`` and *mapped*: the
+      host arrays are the buffers' own memory, no copy;
+    * another device with ``pinned=True`` (a ``Session``): copied into page-locked host buffers
+      (``ALLOC_HOST_PTR``, mapped once and kept), which DMA engines fill at the bus's rate;
+    * otherwise copied into fresh (pageable) NumPy arrays.
+
+    Every ``take`` starts a new generation: a result of an earlier one is stale (its arrays
+    will be overwritten), which ``DeviceOutput.valid`` reports.  Host arrays from a mapping or
+    a pinned buffer are views of memory the next ``take`` reuses too.
+    """
+
+    GROWTH = 1.25
+
+    def __init__(self, tessellator: "Tessellator", pinned: bool = False):
+        self.queue = tessellator.queue
+        self.context = tessellator.context
+        self.mapped = bool(tessellator.device.type & cl.device_type.CPU)
+        self.pinned = pinned and not self.mapped
+        self.generation = 0
+        self._buffers: dict = {}  # name -> (device buffer, capacity in rows)
+        self._staging: dict = {}  # name -> (pinned buffer, its mapped host array)
+        self._maps: list = []
+
+    @staticmethod
+    def _layout():
+        return [(name, np.dtype(dtype), shape) for name, dtype, shape in VERTEX_RECORD] + \
+            [("triangles", np.dtype(np.uint32), (3,))]
+
+    def take(self, num_vertices: int, num_triangles: int) -> dict:
+        """pyopencl arrays of (num_vertices, ...) per vertex field and (num_triangles, 3)
+        triangles, on buffers at least that large; a new generation."""
+        self.generation += 1
+        self.unmap()
+        flags = cl.mem_flags.READ_WRITE | (cl.mem_flags.ALLOC_HOST_PTR if self.mapped else 0)
+        arrays = {}
+        for name, dtype, shape in self._layout():
+            rows = num_triangles if name == "triangles" else num_vertices
+            row_bytes = dtype.itemsize * int(np.prod(shape))
+            buffer, capacity = self._buffers.get(name, (None, -1))
+            if rows > capacity:  # the first allocation as asked; growing, a quarter more
+                capacity = rows if buffer is None else int(rows * self.GROWTH)
+                self._buffers.pop(name, None)
+                self._staging.pop(name, None)
+                buffer = cl.Buffer(self.context, flags, max(capacity, 1) * row_bytes)
+                self._buffers[name] = (buffer, capacity)
+            arrays[name] = cl_array.Array(self.queue, (rows, *shape), dtype, data=buffer)
+        return arrays
+
+    def read_back(self, num_vertices: int, num_triangles: int) -> dict:
+        """The current generation's output as host arrays (see the class)."""
+        host, events = {}, []
+        for name, dtype, shape in self._layout():
+            rows = num_triangles if name == "triangles" else num_vertices
+            buffer, capacity = self._buffers[name]
+            if not rows:
+                host[name] = np.zeros((0, *shape), dtype)
+            elif self.mapped:
+                array, event = cl.enqueue_map_buffer(self.queue, buffer, cl.map_flags.READ | cl.map_flags.WRITE, 0,
+                                                     (rows, *shape), dtype, is_blocking=False)
+                self._maps.append(array.base)  # the pyopencl MemoryMap
+                host[name] = array
+                events.append(event)
+            else:
+                target = self._pinned(name, dtype, shape, capacity)[:rows] if self.pinned \
+                    else np.empty((rows, *shape), dtype)
+                events.append(cl.enqueue_copy(self.queue, target, buffer, is_blocking=False))
+                host[name] = target
+        cl.wait_for_events(events) if events else None
+        return host
+
+    def unmap(self) -> None:
+        """Unmap the host views of the last generation (before the device writes the buffers
+        again, as OpenCL asks).  On a CPU device the views still show the buffers' memory, which
+        the next generation overwrites; the buffers live as long as a view of them does."""
+        if self._maps:
+            cl.wait_for_events([m.release(self.queue) for m in self._maps])
+            self._maps.clear()
+
+    def _pinned(self, name, dtype, shape, capacity) -> np.ndarray:
+        """The page-locked host array of a field (allocated and mapped once per capacity)."""
+        if name not in self._staging:
+            buffer = cl.Buffer(self.context, cl.mem_flags.READ_WRITE | cl.mem_flags.ALLOC_HOST_PTR,
+                               max(capacity, 1) * dtype.itemsize * int(np.prod(shape)))
+            array, _ = cl.enqueue_map_buffer(self.queue, buffer, cl.map_flags.READ | cl.map_flags.WRITE, 0,
+                                             (max(capacity, 1), *shape), dtype, is_blocking=True)
+            self._staging[name] = (buffer, array)
+        return self._staging[name][1]
+
+    @property
+    def nbytes(self) -> int:
+        return sum(buffer.size for buffer, _ in self._buffers.values())
+
+
+@dataclass
+class SceneData:
+    """A scene's device data, whatever the tolerance or camera (``Tessellator.scene_data``):
+    parts: (kind, base, count, its device arrays ``upload``) per kind in scene order; objects:
+    (P,) int32 object ids; groups: stage 2's edge groups (``upload_groups``); stats: the
+    scene's edge and mesh counts."""
+
+    scene: Scene
+    sharp_edges: str
+    num_patches: int
+    parts: list
+    objects: cl_array.Array
+    groups: dict
+    stats: dict
+    events: dict = field(default_factory=dict)  # the uploads' events, reported by the next plan
 
 
 @dataclass

@@ -1,0 +1,100 @@
+"""A frame loop: one scene tessellated again and again as the camera or the tolerance changes.
+
+    session = cltess.Session(scene, pixels=0.5)            # or eps=..., or request=Request(...)
+    for camera in path:
+        frame = session.tessellate(camera=camera)          # the five stages, nothing else
+        draw(frame.device.positions, frame.device.triangles)  # pyopencl arrays, no read-back
+
+What a ``Session`` keeps between calls, so that a frame costs only the five stages:
+
+* the scene's device data (``Tessellator.scene_data``): every kind's upload, the object ids,
+  stage 2's edge groups (the host adjacency behind them is cached on the scene);
+* the per-patch arrays of stages 1-3 (factors, flags, counts, offsets: sized by the scene);
+* the output buffers (``OutputBuffers``), grown only when a frame needs more, and on a GPU the
+  page-locked host buffers its read-back goes through.
+
+A frame's output stays on the device (``Tessellation.device``); its host arrays are read back
+when first asked for (``frame.positions``, ``frame.fetch()``): on a CPU device by mapping the
+buffers (no copy), on a GPU by a copy into the pinned buffers.  Either way they are *views of
+the session's buffers*: valid until the next ``tessellate`` call, which reuses them (a stale
+frame's ``device`` and ``fetch`` raise ``StaleOutput``; host arrays already taken are simply
+overwritten, as a renderer's frame buffers are).  ``.copy()`` what must outlive the frame.
+"""
+from __future__ import annotations
+
+import dataclasses
+import time
+
+from .backends.opencl.tessellator import OutputBuffers, Tessellator
+from .criteria.tolerance import ObjectSpace, ScreenSpace
+from .request import Request
+from .scene import Camera, Scene
+from .tessellation import Tessellation
+
+
+class Session:
+    """Tessellate one scene per frame on one OpenCL device, keeping its device data.
+
+    scene: the scene; device: an OpenCL device or its name (``cltess.device.pick_device``), or
+    give ``tessellator`` (to share its context and programs); request: a ``Request``, or its
+    parts as keywords (``Request.of``: eps= or pixels=, max_factor=, pattern=, ...).
+    """
+
+    def __init__(self, scene: Scene, device=None, request: Request | None = None,
+                 tessellator: Tessellator | None = None, **options):
+        self.tessellator = tessellator if tessellator is not None else Tessellator(device)
+        self.scene = scene
+        self.request = request if request is not None else Request.of(**options)
+        self.request.check(scene)
+        self.output = OutputBuffers(self.tessellator, pinned=True)
+        self._scene_data: dict = {}  # sharp_edges -> SceneData
+        self._scratch: dict = {}  # sharp_edges -> the per-patch arrays of stages 1-3
+        self.frames = 0
+
+    @property
+    def device(self):
+        return self.tessellator.device
+
+    def request_for(self, camera: Camera | None = None, **overrides) -> Request:
+        """The session's request with a frame's changes: ``camera`` (for a pixel tolerance),
+        ``eps`` or ``pixels`` (a new tolerance), and any other ``Request`` field."""
+        request = self.request
+        tolerance = request.tolerance
+        if "eps" in overrides and "pixels" in overrides:
+            raise ValueError("give at most one of eps and pixels")
+        if "eps" in overrides:
+            tolerance = ObjectSpace(overrides.pop("eps"))
+        elif "pixels" in overrides:
+            tolerance = ScreenSpace(overrides.pop("pixels"), getattr(tolerance, "camera", None))
+        if camera is not None:
+            if not isinstance(tolerance, ScreenSpace):
+                raise ValueError("camera= is for a pixel tolerance; this session's is eps "
+                                 f"{tolerance.eps!r} (give pixels= to the session or to this call)")
+            tolerance = ScreenSpace(tolerance.pixels, camera)
+        if tolerance is not request.tolerance or overrides:
+            request = dataclasses.replace(request, tolerance=tolerance, **overrides)
+            request.check(self.scene)
+        return request
+
+    def tessellate(self, camera: Camera | None = None, **request_overrides) -> Tessellation:
+        """One frame: stages 1-5 for the whole scene with this camera (pixel tolerance) and
+        these changes to the session's request (``request_for``).  The output stays on the
+        device (``.device``); host arrays on first use, valid until the next call."""
+        started = time.perf_counter()
+        request = self.request_for(camera, **request_overrides)
+        tessellator = self.tessellator
+        tessellator.compose(self.scene, request)  # found in the cache after the first frame
+        key = request.sharp_edges
+        if key not in self._scene_data:
+            self._scene_data[key] = tessellator.scene_data(self.scene, key)
+            self._scratch[key] = {}
+        plan = tessellator.plan_on(self._scene_data[key], request, started, self._scratch[key])
+        self.frames += 1
+        return tessellator.emit(plan, 0, plan.num_patches, on_device=True, out=self.output)
+
+    def __repr__(self) -> str:
+        return (f"Session({self.scene.name!r}, {self.device.name.strip()!r}, {self.frames} frames, "
+                f"output buffers {self.output.nbytes} bytes)")
+
+
+__all__ = ["Session"]

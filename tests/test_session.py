@@ -1,0 +1,104 @@
+"""Output that stays on the device (Tessellation.device, lazy host arrays), the frame loop
+(cltess.Session) and the wall-clock figures a result carries (issue 15)."""
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import cltess
+from cltess.io import load_scene
+from cltess.scene import Camera
+from cltess.tessellation import HOST_FIELDS, StaleOutput
+
+SCENES = Path(__file__).resolve().parent.parent / "scenes"
+
+
+@pytest.fixture(scope="module")
+def tea_table():
+    return load_scene(SCENES / "tea_table.json")
+
+
+def assert_same(a, b):
+    for name in HOST_FIELDS:
+        assert np.array_equal(getattr(a, name), getattr(b, name)), name
+
+
+def orbit(scene, count):
+    """Cameras on a circle around the scene's camera target, each nearer than the last."""
+    camera = scene.camera
+    target = np.asarray(camera.target, float)
+    offset = np.asarray(camera.eye, float) - target
+    for k in range(count):
+        angle, scale = 2 * np.pi * k / count, 1.0 - 0.15 * k
+        c, s = np.cos(angle), np.sin(angle)
+        turned = np.array([c * offset[0] - s * offset[1], s * offset[0] + c * offset[1], offset[2]])
+        yield Camera(eye=target + scale * turned, target=target, up=camera.up)
+
+
+def test_wall_times_cover_the_read_back(tessellator, tea_table):
+    tess = tessellator.tessellate(tea_table, pixels=0.5)
+    wall = tess.wall_ms
+    assert wall["total"] == pytest.approx(wall["stages"] + wall["read_back"])
+    assert tess.stage_ms["total_wall"] == wall["total"]
+    assert tess.device is None and tess.on_host
+
+
+def test_output_on_the_device_is_read_back_only_when_asked(tessellator, tea_table):
+    plan = tessellator.plan(tea_table, pixels=0.5)
+    tess = tessellator.emit(plan, 0, plan.num_patches, on_device=True)
+    assert not tess.on_host and "read_back" not in tess.wall_ms
+    assert tess.num_vertices == plan.num_vertices and tess.num_triangles == plan.num_indices // 3
+    device = tess.device
+    assert device.positions.shape == (plan.num_vertices, 3) and device.triangles.dtype == np.uint32
+    positions = device.positions.get()  # a pyopencl array: read it without the Tessellation
+    assert not tess.on_host
+    assert np.array_equal(tess.positions, positions)  # the first host field fetches them all
+    assert tess.on_host and tess.wall_ms["total"] >= tess.wall_ms["stages"]
+    assert_same(tess, tessellator.tessellate(tea_table, pixels=0.5))
+
+
+def test_batches_on_the_device_number_vertices_globally(tessellator, tea_table):
+    plan = tessellator.plan(tea_table, eps=0.01)
+    whole = tessellator.emit(plan, 0, plan.num_patches)
+    middle = plan.num_patches // 2
+    second = tessellator.emit(plan, middle, plan.num_patches, on_device=True)
+    assert second.device.vertex_base == plan.vertex_range(middle, plan.num_patches)[0]
+    assert np.array_equal(second.triangles, whole.triangles[plan.index_range(0, middle)[1] // 3:])
+
+
+def test_session_frames_are_bitwise_the_one_shot_results(tessellator, tea_table):
+    session = cltess.Session(tea_table, tessellator=tessellator, pixels=0.5)
+    for camera in orbit(tea_table, 4):
+        frame = session.tessellate(camera=camera)
+        expected = tessellator.tessellate(tea_table, request=session.request_for(camera))
+        assert_same(frame, expected)
+    assert session.frames == 4
+
+
+def test_session_overrides_and_growing_buffers(tessellator, tea_table):
+    session = cltess.Session(tea_table, tessellator=tessellator, eps=0.02)
+    coarse = session.tessellate()
+    size = session.output.nbytes
+    fine = session.tessellate(eps=0.002)  # more output: the buffers grow
+    grown = session.output.nbytes
+    assert grown > size
+    assert_same(fine, tessellator.tessellate(tea_table, eps=0.002))
+    with pytest.raises(StaleOutput):
+        coarse.fetch()
+    with pytest.raises(StaleOutput):
+        coarse.device.positions
+    again = session.tessellate(eps=0.02)  # fewer: the same buffers
+    assert session.output.nbytes == grown
+    assert_same(again, tessellator.tessellate(tea_table, eps=0.02))
+    semi = session.tessellate(eps=0.02, pattern="semi_uniform")
+    assert_same(semi, tessellator.tessellate(tea_table, eps=0.02, pattern="semi_uniform"))
+
+
+def test_session_refuses_what_it_cannot_do(tessellator, tea_table):
+    session = cltess.Session(tea_table, tessellator=tessellator, eps=0.02)
+    with pytest.raises(ValueError, match="pixel tolerance"):
+        session.tessellate(camera=tea_table.camera)
+    with pytest.raises(ValueError, match="at most one"):
+        session.tessellate(eps=0.1, pixels=1.0)
+    with pytest.raises(ValueError, match="eps must be"):
+        session.tessellate(eps=-1.0)
