@@ -29,6 +29,10 @@ STAGE_AXES = {
     # stage 4 by level (levels.py), for a pattern with a template: built when it is asked for
     "level_vertices": ("kind", "pattern"),
     "verify": ("kind",),  # on request only (Tessellator.verify), so not in STAGES
+    # silhouette refinement per frame (silhouette.py; they include criteria/silhouette.h)
+    "silhouette_alpha": (),
+    "silhouette_levels": (),
+    "silhouette_vertices": ("kind", "pattern"),
 }
 
 
