@@ -180,17 +180,20 @@ def silhouette_f(data: EdgeSilhouetteData, eye) -> np.ndarray:
 
 # --- fractional edge levels (section 5) --------------------------------------------------------
 
-def edge_levels(alpha, group_of, bound, max_level: int, edges_of, use_bound: bool = False,
+def edge_levels(alpha, groups, bound, max_level: int, edges_of, use_bound: bool = False,
                 snap: bool = True) -> tuple[np.ndarray, np.ndarray]:
-    """NumPy mirror of kernels/stages/silhouette_levels.cl: (levels (P, 4) float32, records
-    (P, 4) int32).
+    """NumPy mirror of kernels/stages/silhouette_levels.cl and the crack-free pass after it:
+    (levels (P, 4) float32, records (P, 4) int32).
 
-    alpha (G,) per group (float32, as the device has it); group_of (4P,); bound (P, 4): the
-    crack-free dyadic records of the error bound (0: no output, negative: a collapsed edge);
-    edges_of (P,): each patch's edge count.  Edge level ``s_e = M alpha_e`` (float32), with
-    ``use_bound`` the larger of it and the bound's level ``log2 |bound_e|``, at most M; the
-    record (the semi-uniform pattern's) ``2^ceil(s_e)``, or with ``snap=False`` ``2^m`` on every
-    edge, ``m = max_e ceil(s_e)`` (the paper's hanging nodes); a collapsed edge's stays negated."""
+    alpha (G,) per group (float32, as the device has it); groups: the scene's merged EdgeGroups;
+    bound (P, 4): the crack-free dyadic records of the error bound (0: no output, negative: a
+    collapsed edge); edges_of (P,): each patch's edge count.  Edge level ``s_e = M alpha_e``
+    (float32), with ``use_bound`` the larger of it and the bound's level ``log2 |bound_e|``, at
+    most M; the patch level ``m = ceil(max_e s_e)``; the record ``2^m`` on each edge, then with
+    ``snap`` the largest over each edge group (an edge at the larger level of its patches; the
+    semi-uniform pattern snaps the others), a collapsed edge's negated."""
+    from ..crack.adjacency import crack_free_factors
+
     alpha = np.asarray(alpha, np.float32)
     bound = np.asarray(bound, np.int64).reshape(-1, FACTOR_SLOTS)
     count = len(bound)
@@ -201,17 +204,17 @@ def edge_levels(alpha, group_of, bound, max_level: int, edges_of, use_bound: boo
         edges = int(edges_of[p])
         if bound[p, 0] == 0:
             continue
-        q = []
         for e in range(edges):
-            s = np.float32(top * alpha[group_of[FACTOR_SLOTS * p + e]])
+            s = np.float32(top * alpha[groups.group_of[FACTOR_SLOTS * p + e]])
             if use_bound:
                 s = max(s, np.float32(int(abs(bound[p, e])).bit_length() - 1))
-            s = min(s, top)
-            levels[p, e] = s
-            q.append(int(math.ceil(float(s))))
-        m = max(q)
-        for e in range(edges):
-            records[p, e] = (1 << (q[e] if snap else m)) * (-1 if bound[p, e] < 0 else 1)
+            levels[p, e] = min(s, top)
+        records[p, :edges] = 1 << int(math.ceil(float(levels[p].max())))
+    if snap:
+        records = crack_free_factors(records, groups.group_of, groups.group_start, groups.members,
+                                     groups.collapsed_edges)
+    else:
+        records = np.where(bound < 0, -records, records).astype(np.int32)
     return levels, records
 
 

@@ -100,22 +100,33 @@ class SilhouetteRefiner:
             ("silhouette edges", sharp_edges, phi),
             lambda: edge_silhouette_data([(part.kind, host.source, part.base) for host, part in zip(hosts, self.plan.parts)],
                                          groups, count, phi))
+        collapsed = (np.zeros(len(groups.group_of), bool) if groups.collapsed_edges is None
+                     else np.asarray(groups.collapsed_edges, bool))
+        self._group_start, self._members, self._collapsed = (
+            cl_array.to_device(queue, a.astype(np.int32)) for a in (groups.group_start, groups.members, collapsed))
         mids, normals, rules = self.edges.device_arrays()
         self._mids, self._normals, self._rules, self._group_of = (
             cl_array.to_device(queue, a) for a in (mids, normals, rules, groups.group_of.astype(np.int32)))
-        self.group_of = groups.group_of
+        self.groups, self.group_of = groups, groups.group_of
         self._alpha = cl_array.empty(queue, max(self.edges.num_groups, 1), np.float32)
         self._levels = cl_array.empty(queue, (count, FACTOR_SLOTS), np.float32)
+        self._patch_records = cl_array.empty(queue, (count, FACTOR_SLOTS), np.int32)
         self._records = cl_array.empty(queue, (count, FACTOR_SLOTS), np.int32)
         self._scratch_factors = cl_array.empty(queue, (count, FACTOR_SLOTS), np.int32)
         self._scratch_flags = cl_array.empty(queue, count, np.int32)
         programs = tessellator.programs
         self._alpha_kernel = programs.kernel("silhouette_alpha")
         self._levels_kernel = programs.kernel("silhouette_levels")
+        self._crack_free_kernel = programs.kernel("crack_free")
         for part in self.plan.parts:
             programs.kernel("silhouette_vertices", kind=part.kind, pattern=part.pattern)
         queue.finish()
         self.prepare_ms = (time.perf_counter() - started) * 1e3
+
+    def group_members(self, group: int) -> np.ndarray:
+        """The patch-edges (entries of the (P, 4) factor array) of an edge group."""
+        start = self.groups.group_start
+        return self.groups.members[start[group]:start[group + 1]]
 
     # --- per frame -------------------------------------------------------------------------------
 
@@ -133,16 +144,26 @@ class SilhouetteRefiner:
                                    self._normals.data, self._rules.data, np.uint32(groups), eye4,
                                    self._alpha.data)]
 
-    def frame(self, camera, blend: bool | None = None, snap: bool | None = None) -> SilhouetteFrame:
+    def frame(self, camera, blend: bool | None = None, snap: bool | None = None,
+              alpha: np.ndarray | None = None) -> SilhouetteFrame:
         """Tessellate for one camera (a Camera or an eye point); blend/snap: this frame's, else
-        the refiner's."""
+        the refiner's; alpha: (G,) values in [0, 1] to use instead of the camera's (the blending
+        identities: alpha = 1 is uniform level M, alpha = 0 the coarse mesh)."""
         blend = self.blend if blend is None else bool(blend)
         snap = self.snap if snap is None else bool(snap)
         tess = self.tessellator
         queue, plan = tess.queue, self.plan
         started = time.perf_counter()
         eye = eye_of(camera)
-        events = {"alpha": self._run_alpha(eye), "levels": []}
+        if alpha is None:
+            events = {"alpha": self._run_alpha(eye), "levels": []}
+        else:
+            alpha = np.asarray(alpha, np.float32)
+            if alpha.shape != (self.edges.num_groups,) or not ((alpha >= 0) & (alpha <= 1)).all():
+                raise ValueError(f"alpha must be {self.edges.num_groups} values in [0, 1]")
+            if len(alpha):
+                self._alpha[:len(alpha)].set(alpha)
+            events = {"levels": []}
         if self.recompute_controls:  # the paper's dynamic meshes: control points anew each frame
             events["factors"] = []
             for part in plan.parts:
@@ -153,7 +174,14 @@ class SilhouetteRefiner:
             events["levels"].append(self._levels_kernel(
                 queue, _global_size(part.count), None, self._alpha.data, self._group_of.data, plan.factors.data,
                 np.uint32(part.base), np.uint32(part.count), np.int32(part.kind.edges), np.float32(self.max_level),
-                np.int32(self.eps is not None), np.int32(snap), self._levels.data, self._records.data))
+                np.int32(self.eps is not None), np.int32(snap), self._levels.data,
+                (self._patch_records if snap else self._records).data))
+        if snap:  # each edge at the larger level of its patches (crack/max.h), collapsed ones negated
+            edges = self._records.size
+            events["levels"].append(self._crack_free_kernel(
+                queue, _global_size(edges), None, self._patch_records.data, self._group_of.data,
+                self._group_start.data, self._members.data, self._collapsed.data, np.uint32(edges),
+                self._records.data))
         vertex_offsets, index_offsets, events["counts"] = tess.stage_counts(
             self._records, [(part.pattern, part.base, part.count) for part in plan.parts])
         num_vertices = int(vertex_offsets[plan.num_patches].get())
