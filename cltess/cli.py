@@ -208,10 +208,11 @@ def build_parser() -> argparse.ArgumentParser:
                         help="cap on the memory the output may take at once (e.g. 512M, 2G); a larger "
                              "output is tessellated in batches (streamed to a per-patch .ply or .obj). "
                              "Default: half the device's memory")
-    shared.add_argument("--sharp-edges", choices=("straight", "average", "keep"), default="straight",
+    shared.add_argument("--sharp-edges", choices=("straight", "average", "keep", "crease"), default="straight",
                         help="meshes: an edge whose two sides have different vertex normals becomes a "
-                             "straight crease (default), a curve from the averaged normals, or keeps "
-                             "each side's own PN curve (may crack)")
+                             "straight crease (default), a curve from the averaged normals, keeps "
+                             "each side's own PN curve (may crack), or follows the crease direction "
+                             "n_s x n_t at its sharp ends (crease; Dyken et al. 2008)")
     shared.add_argument("--crease-angle", type=_crease_angle, default=DEFAULT_CREASE_ANGLE, metavar="DEG",
                         help="meshes without normals in the file: edges whose faces meet at more than DEG "
                              f"degrees stay sharp creases (default {DEFAULT_CREASE_ANGLE:g}; 180: all smooth)")
@@ -284,7 +285,7 @@ def build_parser() -> argparse.ArgumentParser:
     batch.add_argument("--no-fd", action="store_true", help="as for tessellate")
     batch.add_argument("--max-factor", type=_factor, default=DEFAULT_MAX_FACTOR, metavar="N",
                        help=f"as for tessellate (default {DEFAULT_MAX_FACTOR})")
-    batch.add_argument("--sharp-edges", choices=("straight", "average", "keep"), default="straight",
+    batch.add_argument("--sharp-edges", choices=("straight", "average", "keep", "crease"), default="straight",
                        help="as for tessellate")
     batch.add_argument("--device", metavar="NAME",
                        help="OpenCL device of every worker (default: one GPU per worker where there are "

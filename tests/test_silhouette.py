@@ -321,3 +321,68 @@ def test_bad_input_is_refused(tessellator, sphere, refiner):
         refiner.frame([0, 0, float("nan")])
     with pytest.raises(ValueError, match="alpha"):
         refiner.frame([0, 0, 5.0], alpha=np.full(refiner.edges.num_groups, 2.0))
+
+
+# --- crease construction (--sharp-edges crease, section 4) -----------------------------------------
+
+@pytest.fixture(scope="module")
+def cylinder(tmp_path_factory):
+    path = tmp_path_factory.mktemp("crease") / "cylinder.stl"
+    trimesh.creation.cylinder(radius=0.5, height=1.0, sections=12).export(path)
+    from cltess.io import load_scene
+    return load_scene(path)
+
+
+def test_crease_keeps_smooth_ends_bitwise_and_follows_the_rim(tessellator, cylinder):
+    keep = tessellator.plan(cylinder, eps=1e-3, sharp_edges="keep")
+    crease = tessellator.plan(cylinder, eps=1e-3, sharp_edges="crease")
+    a, b = keep.parts[0].data["controls"].get(), crease.parts[0].data["controls"].get()
+    source = PN.prepare(cylinder, "crease").source
+    vertex_normals = source[:, 3:6, :3]
+    smooth_ends = moved = 0
+    for e in range(3):
+        for end, corner, slot in ((0, e, 3 + 2 * e), (1, (e + 1) % 3, 4 + 2 * e)):
+            row = source[:, 6 + 2 * e + end]
+            smooth = (row[:, 3] == 0) & (row[:, :3] == vertex_normals[:, corner]).all(axis=1)
+            assert np.array_equal(a[smooth, slot], b[smooth, slot])  # today's PN, bitwise
+            moved += int((a[~smooth, slot] != b[~smooth, slot]).any(axis=1).sum())
+            smooth_ends += int(smooth.sum())
+    assert 0 < smooth_ends < 6 * len(source) and (source[:, 6:12, 3] == 1).any() and moved > 0
+    # the rim (side normal x cap normal = the circle's tangent): the crease curve follows the circle
+    radii = {}
+    for mode in ("straight", "crease"):
+        tess = tessellator.tessellate(cylinder, eps=1e-4, sharp_edges=mode)
+        faces = cylinder.meshes[0].vertices[cylinder.meshes[0].faces]
+        face_normal = np.cross(faces[:, 1] - faces[:, 0], faces[:, 2] - faces[:, 0])
+        side = np.abs(face_normal[:, 2]) < 1e-9 * np.linalg.norm(face_normal, axis=1)
+        rim = (np.abs(np.abs(tess.positions[:, 2]) - 0.5) < 1e-6) & side[tess.patch_ids]
+        radii[mode] = np.abs(np.linalg.norm(tess.positions[rim, :2], axis=1) - 0.5).max()
+        welded = tess.welded()
+        assert welded.stats["welded_boundary_edges"] == 0, mode
+    print("largest distance of the rim from the circle:", radii)
+    assert radii["crease"] < 0.2 * radii["straight"]
+
+
+def test_crease_curves_are_one_from_both_sides(tessellator, cylinder):
+    """Both triangles at a sharp edge build bitwise the same boundary curve (watertight weld)."""
+    plan = tessellator.plan(cylinder, eps=1e-3, sharp_edges="crease")
+    controls = plan.parts[0].data["controls"].get()
+    source = PN.prepare(cylinder, "crease").source
+    assert (source[:, 6:12, 3] == 1).any()
+    reference = pn_control_points(source.astype(np.float64))
+    assert np.abs(reference[:, :10, :3] - controls[:, :10, :3]).max() < 1e-6
+    from cltess.kinds.pn import mesh_edge_groups
+    mesh = cylinder.meshes[0]
+    groups, sharp = mesh_edge_groups(mesh.vertices[mesh.faces], mesh.normals[mesh.faces])
+    curves = np.stack([controls[:, [0, 3, 4, 1]], controls[:, [1, 5, 6, 2]], controls[:, [2, 7, 8, 0]]], axis=1)
+    curves = curves.reshape(-1, 4, 4)
+    for g in np.unique(groups.group_of[sharp]):
+        first, second = groups.members[groups.group_start[g]:groups.group_start[g + 1]]
+        assert np.array_equal(curves[first], curves[second][::-1])
+
+
+def test_silhouette_frames_with_creases_stay_closed(tessellator, cylinder, rng):
+    refiner = SilhouetteRefiner(tessellator, cylinder, max_level=M, sharp_edges="crease", phi=20.0)
+    for eye in random_eyes(rng, 3, (2.0, 4.0)):
+        welded = refiner.frame(eye).tessellation.welded()
+        assert welded.stats["welded_boundary_edges"] == 0 and welded.stats["welded_t_junctions"] == 0
