@@ -154,6 +154,12 @@ def _max_level(text: str) -> int:
     return value
 
 
+def _phi(text: str) -> float:
+    from cltess.frames import parse_phi
+
+    return parse_phi(text)
+
+
 def _memory_size(text: str) -> int:
     from cltess.stream import parse_size
 
@@ -212,10 +218,11 @@ def build_parser() -> argparse.ArgumentParser:
                         help="cap on the memory the output may take at once (e.g. 512M, 2G); a larger "
                              "output is tessellated in batches (streamed to a per-patch .ply or .obj). "
                              "Default: half the device's memory")
-    shared.add_argument("--sharp-edges", choices=("straight", "average", "keep"), default="straight",
+    shared.add_argument("--sharp-edges", choices=("straight", "average", "keep", "crease"), default="straight",
                         help="meshes: an edge whose two sides have different vertex normals becomes a "
-                             "straight crease (default), a curve from the averaged normals, or keeps "
-                             "each side's own PN curve (may crack)")
+                             "straight crease (default), a curve from the averaged normals, keeps "
+                             "each side's own PN curve (may crack), or follows the crease direction "
+                             "n_s x n_t at its sharp ends (crease; Dyken et al. 2008)")
     shared.add_argument("--crease-angle", type=_crease_angle, default=DEFAULT_CREASE_ANGLE, metavar="DEG",
                         help="meshes without normals in the file: edges whose faces meet at more than DEG "
                              f"degrees stay sharp creases (default {DEFAULT_CREASE_ANGLE:g}; 180: all smooth)")
@@ -264,6 +271,28 @@ def build_parser() -> argparse.ArgumentParser:
                           "mesh at equal (u, v), at 28 points in every triangle (every k-th triangle above "
                           "4 million), and print it beside the requested tolerance")
 
+    # Per-frame cameras (issue 12): one tessellation per camera of a path (cltess/frames.py).
+    frames = run.add_argument_group("per-frame cameras")
+    frames.add_argument("--camera-path", metavar="FILE.json",
+                        help="tessellate once per camera of this path (a list of cameras or an orbit; "
+                             "cltess.io.camera_path), preparing the scene once; -o names each frame's "
+                             "mesh with {frame} (out_{frame:04d}.ply), or -o FILE.json writes a summary "
+                             "per frame; needs --silhouette or --pixels")
+    frames.add_argument("--silhouette", type=_max_level, nargs="?", const=3, metavar="M",
+                        help="silhouette refinement with blended levels (Dyken et al. 2008): edges at "
+                             "level M (default 3) where the surface turns away from the eye, 0 far from "
+                             "it, watertight (semi-uniform snap); every edge keeps at least --eps's level "
+                             "unless --no-bound; the scene's camera without --camera-path")
+    frames.add_argument("--no-bound", action="store_true",
+                        help="--silhouette: levels from the silhouettes alone (the paper), --eps not kept")
+    frames.add_argument("--phi", type=_phi, metavar="DEG",
+                        help="--silhouette: the transition wedge's angle about the faces (default: the "
+                             "paper's constant beta = 1/4)")
+    frames.add_argument("--no-blend", action="store_true",
+                        help="--silhouette: each vertex at its integer level (pops between frames; the ablation)")
+    frames.add_argument("--no-snap", action="store_true",
+                        help="--silhouette: no snap, the paper's hanging nodes (T-junctions; the ablation)")
+
     render = commands.add_parser(
         "render", help="tessellate a scene and draw it into a PNG (no display needed)",
         parents=[verbose, shared],
@@ -292,7 +321,7 @@ def build_parser() -> argparse.ArgumentParser:
     batch.add_argument("--no-fd", action="store_true", help="as for tessellate")
     batch.add_argument("--max-factor", type=_factor, default=DEFAULT_MAX_FACTOR, metavar="N",
                        help=f"as for tessellate (default {DEFAULT_MAX_FACTOR})")
-    batch.add_argument("--sharp-edges", choices=("straight", "average", "keep"), default="straight",
+    batch.add_argument("--sharp-edges", choices=("straight", "average", "keep", "crease"), default="straight",
                        help="as for tessellate")
     batch.add_argument("--pattern", choices=tuple(PATTERN_CHOICES), default="transition", help="as for tessellate")
     batch.add_argument("--max-level", type=_max_level, default=6, metavar="L", help="as for tessellate (default 6)")
@@ -439,7 +468,7 @@ def _prepare_scene(args):
         from cltess.orient import orient_scene
 
         scene, orientation = orient_scene(scene)
-    if args.pixels is not None and scene.camera is None:
+    if args.pixels is not None and scene.camera is None and getattr(args, "camera_path", None) is None:
         raise UsageError(f"{args.scene}: --pixels needs a camera in the scene (use a .json scene "
                          "with a \"camera\", or give --eps)")
     eps_text = None
@@ -495,6 +524,8 @@ def _progress(args, what: str):
 
 def cmd_tessellate(args) -> int:
     """Load, tessellate, export, summarise."""
+    if args.camera_path is not None or args.silhouette is not None:
+        return cmd_tessellate_frames(args)
     from cltess.device import pick_device
     from cltess.io.export import estimate_output_bytes, estimate_write_seconds
     from cltess.limits import OutputTooLarge
@@ -577,6 +608,46 @@ def cmd_tessellate(args) -> int:
     if not args.quiet:
         print(format_summary(result.stats, result.stage_ms, scene=args.scene, device=device.name.strip(),
                              tolerance=eps_text, output=output if preview is None else f"{output}, {preview}"))
+    return EXIT_OK
+
+
+def cmd_tessellate_frames(args) -> int:
+    """--camera-path / --silhouette: one tessellation per camera (cltess/frames.py)."""
+    from cltess.device import pick_device
+    from cltess.frames import FramesError, check_options, frame_path, run_frames
+    from cltess.io.camera_path import read_camera_path
+
+    cameras = read_camera_path(args.camera_path) if args.camera_path is not None else None
+    try:
+        what = check_options(args, len(cameras) if cameras else 1)
+        first = Path(args.output) if what == "summary" else frame_path(args.output, 0)
+    except FramesError as error:
+        raise UsageError(str(error)) from None
+    if what == "meshes":
+        _check_output_path(first)
+    elif not first.parent.is_dir():
+        raise UsageError(f"{first}: folder {str(first.parent)!r} does not exist")
+    for index in range(len(cameras) if cameras else 1):
+        _refuse_overwriting_an_input(Path(args.output) if what == "summary" else frame_path(args.output, index),
+                                     args.scene)
+    scene, orientation, eps_text = _prepare_scene(args)
+    if cameras is None:
+        if scene.camera is None:
+            raise UsageError(f"{args.scene}: --silhouette needs a camera: a .json scene with a \"camera\", "
+                             "or --camera-path")
+        cameras = [scene.camera]
+    device = pick_device(args.device)
+    from cltess.pipeline import Tessellator  # lazy: builds OpenCL programs
+
+    args.pattern_name = PATTERN_CHOICES[args.pattern]
+    weld = args.weld if args.weld is not None else first.suffix.lower() in MESH_FORMATS
+    say = (lambda text: None) if args.quiet else (lambda text: print(text))
+    summaries = run_frames(args, scene, cameras, Tessellator(device=device), weld, say)
+    if not args.quiet:
+        total = sum(s["device_ms"] for s in summaries)
+        print(f"{len(summaries)} frame{'s' if len(summaries) != 1 else ''} of {args.scene} on "
+              f"{device.name.strip()} ({eps_text}): {total:.2f} ms on the device in all"
+              + (f"; summary in {args.output}" if what == "summary" else ""))
     return EXIT_OK
 
 

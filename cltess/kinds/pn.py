@@ -22,8 +22,9 @@ from ..surfaces import pn as surface
 from ..surfaces.pn import pn_control_points, pn_folded
 from .base import FLAG_CULLED, FLAG_FOLDED, KindInput, PatchKind
 
-#: How ``pn_edge_normals`` treats a sharp edge (different normals on its two sides).
-SHARP_EDGE_MODES = ("straight", "average", "keep")
+#: How ``pn_edge_normals`` treats a sharp edge (different normals on its two sides); "crease":
+#: ``pn_crease_ends``.
+SHARP_EDGE_MODES = ("straight", "average", "keep", "crease")
 
 
 def mesh_edge_groups(corners: np.ndarray, normals: np.ndarray | None = None) -> tuple[EdgeGroups, np.ndarray]:
@@ -72,8 +73,9 @@ def pn_edge_normals(normals: np.ndarray, groups: EdgeGroups, sharp: np.ndarray, 
     mean of the sides' normals there, the same on every side (watertight, a curved crease);
     ``"keep"`` each side's own normals, as plain PN triangles do (the surface may crack there).
     """
-    if mode not in SHARP_EDGE_MODES:
-        raise ValueError(f"sharp_edges must be one of {', '.join(SHARP_EDGE_MODES)}, got {mode!r}")
+    if mode not in SHARP_EDGE_MODES or mode == "crease":
+        raise ValueError(f"sharp_edges must be one of {', '.join(SHARP_EDGE_MODES[:3])}, got {mode!r}"
+                         + (" (crease ends: pn_crease_ends)" if mode == "crease" else ""))
     normals = np.asarray(normals, np.float32)
     out = np.stack([normals, np.roll(normals, -1, axis=1)], axis=2)  # (T, 3, 2, 3)
     flat = out.reshape(-1, 2, 3)
@@ -91,6 +93,44 @@ def pn_edge_normals(normals: np.ndarray, groups: EdgeGroups, sharp: np.ndarray, 
         flat[sharp] = np.where(flipped[sharp][:, None, None], own[:, ::-1], own)
     return out
 
+
+
+def pn_crease_ends(normals: np.ndarray, groups: EdgeGroups, sharp: np.ndarray) -> np.ndarray:
+    """``sharp_edges="crease"`` (Dyken, Reimers and Seland 2008, section 4): (T, 3, 2, 4) float32,
+    what each edge end's boundary curve uses, in the layout of ``pn_edge_normals`` with a w.
+
+    A smooth end (its two sides' normals bitwise equal) keeps its vertex normal (w = 0), so it
+    is bitwise today's PN.  A sharp end of an edge of two triangles, normals n_s and n_t there,
+    follows the crease: ``t = normalize(n_s x n_t)`` with w = 1, and its inner control point is
+    ``p + ((q - p) . t) / 3 t`` (kernels/kinds/pn.h pn_end_control).  t is made once per edge
+    end, from the group's first member's normal crossed with the second's at the same welded
+    end, and given to both sides, so the curve is bitwise one.  A sharp end whose normals are
+    opposite (no cross product) and the sharp ends of edges of more than two triangles take the
+    straight edge (normal 0), as ``"straight"`` does."""
+    normals = np.asarray(normals, np.float32)
+    own = np.stack([normals, np.roll(normals, -1, axis=1)], axis=2).reshape(-1, 2, 3)  # (3T, 2, 3)
+    out = np.zeros((len(own), 2, 4), np.float32)
+    out[:, :, :3] = own
+    if not sharp.any():
+        return out.reshape(-1, 3, 2, 4)
+    flipped = groups.flipped
+    canonical = np.where(flipped[:, None, None], own[:, ::-1], own)  # (low end, high end)
+    sizes = groups.group_sizes[groups.group_of]
+    first = groups.members[groups.group_start[:-1]][groups.group_of]
+    second = groups.members[np.minimum(groups.group_start[:-1] + 1, groups.group_start[1:] - 1)][groups.group_of]
+    n_s, n_t = canonical[first].astype(np.float64), canonical[second].astype(np.float64)
+    cross = np.cross(n_s, n_t)
+    length = np.linalg.norm(cross, axis=-1, keepdims=True)
+    tangent = np.where(length > 0, cross / np.where(length > 0, length, 1.0), 0.0).astype(np.float32)
+    differs = (canonical[first].view(np.uint32) != canonical[second].view(np.uint32)).any(axis=-1)  # (3T, 2)
+    crease = sharp[:, None] & (sizes == 2)[:, None] & differs & (length[..., 0] > 0)
+    straight = sharp[:, None] & differs & ~crease
+    ends = np.zeros((len(own), 2, 4), np.float32)
+    ends[:, :, :3] = np.where(crease[..., None], tangent, np.where(straight[..., None], 0.0, canonical))
+    ends[:, :, 3] = crease
+    mine = np.where(flipped[:, None, None], ends[:, ::-1], ends)  # back to (start, end) of each patch-edge
+    out[sharp] = mine[sharp]
+    return out.reshape(-1, 3, 2, 4)
 
 
 class PNKind(PatchKind):
@@ -113,7 +153,10 @@ class PNKind(PatchKind):
         source[:, 0:3, :3] = corners
         source[:, 0:3, 3] = 1.0
         source[:, 3:6, :3] = normals
-        source[:, 6:12, :3] = pn_edge_normals(normals, groups, sharp, sharp_edges).reshape(-1, 6, 3)
+        if sharp_edges == "crease":
+            source[:, 6:12] = pn_crease_ends(normals, groups, sharp).reshape(-1, 6, 4)
+        else:
+            source[:, 6:12, :3] = pn_edge_normals(normals, groups, sharp, sharp_edges).reshape(-1, 6, 3)
         objects = np.concatenate([np.full(m.num_faces, m.object_id, np.int32) for m in meshes])
         stats = {
             "pn_triangles": len(corners),

@@ -39,6 +39,15 @@ def pn_edge_control(p_near: np.ndarray, p_far: np.ndarray, n_near: np.ndarray) -
     return (2 * p_near + p_far - w * n_near) / 3
 
 
+def pn_end_control(p_near: np.ndarray, p_far: np.ndarray, n_near: np.ndarray) -> np.ndarray:
+    """An edge end's inner control point from its input row (x, y, z, w): PN's
+    (``pn_edge_control``) for w = 0, at a crease end (w != 0, t = n_near.xyz) p_near + ((p_far -
+    p_near) . t) / 3 t (kernels/kinds/pn.h pn_end_control)."""
+    t = n_near[..., :3]
+    crease = p_near + ((p_far - p_near) * t).sum(-1, keepdims=True) / 3 * t
+    return np.where(n_near[..., 3:] != 0, crease, pn_edge_control(p_near, p_far, t))
+
+
 def _unit_or_zero(a: np.ndarray) -> np.ndarray:
     length = np.linalg.norm(a, axis=-1, keepdims=True)
     return np.where(length > 0, a / np.where(length > 0, length, 1), 0.0)
@@ -53,14 +62,14 @@ def pn_control_points(triangles: np.ndarray) -> np.ndarray:
     P1 = P2).  Mirror of kernels/cltess.h pn_control_points.
     """
     triangles = np.asarray(triangles, float)
-    P, N, E = triangles[:, 0:3, :3], triangles[:, 3:6, :3], triangles[:, 6:12, :3]
+    P, N = triangles[:, 0:3, :3], triangles[:, 3:6, :3]
     out = np.zeros((len(triangles), 16, 4))
     out[:, :10, 3] = 1.0
     out[:, 0:3, :3] = P
     for e in range(3):
         p, q = P[:, e], P[:, (e + 1) % 3]
-        out[:, 3 + 2 * e, :3] = pn_edge_control(p, q, E[:, 2 * e])
-        out[:, 4 + 2 * e, :3] = pn_edge_control(q, p, E[:, 2 * e + 1])
+        out[:, 3 + 2 * e, :3] = pn_end_control(p, q, triangles[:, 6 + 2 * e])
+        out[:, 4 + 2 * e, :3] = pn_end_control(q, p, triangles[:, 7 + 2 * e])
         d = q - p
         length2 = (d * d).sum(-1, keepdims=True)
         v = np.where(length2 > 0, 2 * (d * (N[:, e] + N[:, (e + 1) % 3])).sum(-1, keepdims=True)

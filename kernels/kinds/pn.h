@@ -23,6 +23,18 @@ inline float3 pn_edge_control(float3 p_near, float3 p_far, float3 n_near)
     return (2.0f * p_near + p_far - w * n_near) / 3.0f;
 }
 
+/* The inner control point next to p_near of an edge end's curve: PN's (pn_edge_control) from
+ * the end's normal (w = 0), or at a crease end (w = 1, cltess/kinds/pn.py pn_crease_ends;
+ * Dyken, Reimers and Seland 2008, section 4) along the crease direction t = n_s x n_t:
+ * p_near + ((p_far - p_near) . t) / 3 t.  The other side computes the same point from the
+ * same t. */
+inline float3 pn_end_control(float3 p_near, float3 p_far, float4 n_near)
+{
+    if (n_near.w != 0.0f)
+        return p_near + dot3(p_far - p_near, n_near.xyz) / 3.0f * n_near.xyz;
+    return pn_edge_control(p_near, p_far, n_near.xyz);
+}
+
 /* n_ij of the quadratic normal field: normalize(N_i + N_j - v_ij (P_j - P_i)),
  * v_ij = 2 (P_j - P_i).(N_i + N_j) / |P_j - P_i|^2 (0 on a zero-length edge). */
 inline float3 pn_mid_normal(float3 p_i, float3 p_j, float3 n_i, float3 n_j)
@@ -46,8 +58,8 @@ inline void pn_control_points(const float4 in[12], float4 b[16])
     __attribute__((opencl_unroll_hint))
     for (int e = 0; e < 3; ++e) {
         float3 p = in[e].xyz, q = in[(e + 1) % 3].xyz;
-        float3 near = pn_edge_control(p, q, in[6 + 2 * e].xyz);
-        float3 far = pn_edge_control(q, p, in[7 + 2 * e].xyz);
+        float3 near = pn_end_control(p, q, in[6 + 2 * e]);
+        float3 far = pn_end_control(q, p, in[7 + 2 * e]);
         b[3 + 2 * e] = (float4)(near, 1.0f);
         b[4 + 2 * e] = (float4)(far, 1.0f);
         sum += near + far;

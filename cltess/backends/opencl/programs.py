@@ -31,6 +31,10 @@ STAGE_AXES = {
     "level_indices": ("pattern",),  # two kernels: level_interior, level_band
     "verify": ("kind",),  # on request only (Tessellator.verify), so not in STAGES
     "constants": ("kind",),  # once per scene for kinds with per_patch_constants (Tessellator.upload)
+    # silhouette refinement per frame (silhouette.py; they include criteria/silhouette.h)
+    "silhouette_alpha": (),
+    "silhouette_levels": (),
+    "silhouette_vertices": ("kind", "pattern"),
 }
 
 
