@@ -48,6 +48,10 @@ class Tessellation(IndexedMesh):
                 (f0, f1, f2, 0))
     stage_ms:   device milliseconds per stage, from OpenCL profiling events
     stats:      counts for the summary: patches, culled, saturated, shared/boundary edges...
+    strips:     (S,) uint32 triangle strips of the strip patterns' patches (SD-2), restart-
+                separated (cltess.strips), or None; they expand to those patches' triangles
+    real_factors: (P, 4) float32 real edge factors where a pattern is fractional (SD-2; there
+                ``factors`` are each edge's segments, the odd ceiling), else None
     """
 
     positions: np.ndarray
@@ -59,6 +63,8 @@ class Tessellation(IndexedMesh):
     factors: np.ndarray
     stage_ms: dict = field(default_factory=dict)
     stats: dict = field(default_factory=dict)
+    strips: np.ndarray | None = None
+    real_factors: np.ndarray | None = None
 
     def welded(self, uv: str = "drop", check_t_junctions: bool = True):
         """One indexed mesh per object, shared boundary vertices merged exactly
