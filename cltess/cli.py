@@ -137,7 +137,7 @@ def _crease_angle(text: str) -> float:
 
 
 #: --pattern's choices: the pattern families (cltess.patterns.FAMILIES), as the command line spells them.
-PATTERN_CHOICES = {"transition": "transition", "semi-uniform": "semi_uniform"}
+PATTERN_CHOICES = {"transition": "transition", "semi-uniform": "semi_uniform", "sd2": "sd2"}
 #: --emit's choices: cltess.request.EMIT_MODES, as the command line spells them.
 EMIT_CHOICES = {"per-patch": "per_patch", "by-level": "by_level"}
 
@@ -240,6 +240,16 @@ def build_parser() -> argparse.ArgumentParser:
                         help="semi-uniform: run stages 4-5 per patch (default), or by level: the patches in one "
                              "queue per level, each level evaluated from one shared template (Dyken et al. "
                              "2009, section 4.2; direct evaluation, the same mesh as --no-fd)")
+    # SD-2 (issue 13, docs/sd2.md): real edge factors from a per-vertex level function
+    shared.add_argument("--level-function", choices=("depth", "silhouette", "bound"),
+                        help="sd2: edge factors from the distance to the camera's eye plane, the silhouette "
+                             "(crossed edges get the high factor), or the error bound kept (the default "
+                             "with --pattern sd2); implies --pattern sd2 for meshes")
+    shared.add_argument("--level-factors", type=float, nargs=2, default=(1.0, 7.0), metavar=("LOW", "HIGH"),
+                        help="sd2 depth: the factors at the far and near end; silhouette: of plain and "
+                             "crossed edges (default 1 7)")
+    shared.add_argument("--depth-map", choices=("linear", "quadratic"), default="linear",
+                        help="sd2 depth: the paper's g1 (linear, default) or g2 (quadratic) map")
     shared.add_argument("-q", "--quiet", action="store_true",
                         help="print nothing on success, no progress bar (warnings still go to stderr)")
 
@@ -547,6 +557,7 @@ def cmd_tessellate(args) -> int:
 
     tessellator = Tessellator(device=device)
     mesh_options = {"sharp_edges": args.sharp_edges} if scene.meshes else {}
+    mesh_options.update(_level_options(args, scene))
     def before_writing(plan):
         """After stages 1-3, before anything big exists: warn, estimate, refuse."""
         _warn_saturated(int(plan.stats.get("saturated", 0)), args)
@@ -665,6 +676,7 @@ def cmd_render(args) -> int:
 
     tessellator = Tessellator(device=device)
     mesh_options = {"sharp_edges": args.sharp_edges} if scene.meshes else {}
+    mesh_options.update(_level_options(args, scene))
     plan = tessellator.plan(scene, eps=args.eps, pixels=args.pixels, max_factor=args.max_factor,
                             pattern=PATTERN_CHOICES[args.pattern], max_level=args.max_level,
                             emit=EMIT_CHOICES[args.emit], **mesh_options)
@@ -689,6 +701,16 @@ def cmd_render(args) -> int:
         print(format_summary(stats, {}, scene=args.scene, device=device.name.strip(), tolerance=tolerance,
                              output=f"{output} ({image.shape[1]}x{image.shape[0]})"))
     return EXIT_OK
+
+
+def _level_options(args, scene) -> dict:
+    """The SD-2 level-function options of a run (none unless --pattern sd2 or --level-function)."""
+    if args.level_function is not None and args.pattern == "transition":
+        args.pattern = "sd2"  # --level-function implies it (transition is only the default)
+    if args.pattern != "sd2":
+        return {}
+    return {"level_function": args.level_function, "level_factors": tuple(args.level_factors),
+            "depth_map": args.depth_map}
 
 
 def _warn_saturated(saturated: int, args) -> None:

@@ -19,7 +19,8 @@ from .patterns.semi_uniform import DEFAULT_MAX_LEVEL
 MAX_LEVEL = MAX_FACTOR.bit_length() - 1
 #: Request.emit's values: stages 4-5 per patch, or by level (cltess/backends/opencl/levels.py).
 EMIT_MODES = ("per_patch", "by_level")
-from .scene import Scene
+from .scene import Camera, Scene
+from .levels import DEFAULT_LEVEL_FACTORS, DEPTH_MAPS, LEVEL_FUNCTIONS
 
 
 @dataclass(frozen=True)
@@ -41,6 +42,14 @@ class Request:
                     from the level's template, Dyken et al. 2009 section 4.2; direct evaluation;
                     other patterns' patches per patch).  The same mesh either way, bit for bit
                     (per_patch without forward differencing).
+    level_function: the SD-2 pattern's edge factors (cltess.levels): "depth", "silhouette" or
+                    "bound" (the error bound kept; the default for pattern "sd2"); giving one
+                    selects pattern "sd2" for the triangle kinds.
+    level_factors:  (low, high) real factors of "depth" (far, near) and "silhouette" (plain,
+                    crossed edges), within 1 .. max_factor.
+    depth_map:      "linear" (g1) or "quadratic" (g2) for "depth".
+    depth_range:    (near, far) depths mapped onto (high, low); None: this frame's range.
+    camera:         the camera of "depth" and "silhouette" (None: the scene's).
     """
 
     tolerance: ObjectSpace | ScreenSpace
@@ -50,6 +59,11 @@ class Request:
     pattern: str | None = None
     max_level: int = DEFAULT_MAX_LEVEL
     emit: str = "per_patch"
+    level_function: str | None = None
+    level_factors: tuple = DEFAULT_LEVEL_FACTORS
+    depth_map: str = "linear"
+    depth_range: tuple | None = None
+    camera: Camera | None = None
 
     def __post_init__(self):
         value = self.tolerance.eps if isinstance(self.tolerance, ObjectSpace) else self.tolerance.pixels
@@ -67,6 +81,24 @@ class Request:
             raise ValueError(f"max_level must be an integer in 0..{MAX_LEVEL}, got {self.max_level!r}")
         if self.emit not in EMIT_MODES:
             raise ValueError(f"emit must be one of {', '.join(EMIT_MODES)}, got {self.emit!r}")
+        if self.level_function is not None and self.level_function not in LEVEL_FUNCTIONS:
+            raise ValueError(f"level_function must be one of {', '.join(LEVEL_FUNCTIONS)}, got {self.level_function!r}")
+        if self.level_function is not None and self.pattern not in (None, "sd2"):
+            raise ValueError(f"level_function needs pattern 'sd2', got pattern {self.pattern!r}")
+        low_high = tuple(self.level_factors) if isinstance(self.level_factors, (tuple, list)) else ()
+        if len(low_high) != 2 or not all(isinstance(x, numbers.Real) and math.isfinite(x) for x in low_high) \
+                or not 1 <= low_high[0] <= low_high[1] <= self.max_factor:
+            raise ValueError(f"level_factors must be (low, high) with 1 <= low <= high <= max_factor "
+                             f"({self.max_factor}), got {self.level_factors!r}")
+        if self.depth_map not in DEPTH_MAPS:
+            raise ValueError(f"depth_map must be one of {', '.join(DEPTH_MAPS)}, got {self.depth_map!r}")
+        if self.depth_range is not None and not (
+                len(self.depth_range) == 2 and all(isinstance(x, numbers.Real) and math.isfinite(x)
+                                                   for x in self.depth_range)
+                and self.depth_range[0] < self.depth_range[1]):
+            raise ValueError(f"depth_range must be (near, far) with near < far, got {self.depth_range!r}")
+        if self.camera is not None and not isinstance(self.camera, Camera):
+            raise ValueError(f"camera must be a cltess.scene.Camera, got {type(self.camera).__name__}")
 
     @classmethod
     def of(cls, eps: float | None = None, pixels: float | None = None, **options) -> "Request":
@@ -87,6 +119,9 @@ class Request:
         """What the request needs of the scene: patches, and a camera for a pixel tolerance."""
         if isinstance(self.tolerance, ScreenSpace) and self.tolerance.camera is None and scene.camera is None:
             raise ValueError(f"{scene.name}: a pixel tolerance needs a camera in the scene")
+        if self.level_function in ("depth", "silhouette") and self.camera is None and scene.camera is None:
+            raise ValueError(f"{scene.name}: level function {self.level_function!r} needs a camera "
+                             "(Request.camera, or one in the scene)")
         if scene.num_patches == 0:
             raise ValueError(f"{scene.name}: the scene has no patches")
         check_patch_count(scene.name, scene.num_patches)
@@ -94,5 +129,11 @@ class Request:
     def pattern_for(self, kind):
         """The pattern a kind is tessellated with: the requested one where its domain is the
         kind's, else the kind's own."""
-        chosen = pattern_named(self.pattern, kind.domain) if self.pattern is not None else None
+        pattern = "sd2" if self.level_function is not None and self.pattern is None else self.pattern
+        chosen = pattern_named(pattern, kind.domain) if pattern is not None else None
         return chosen if chosen is not None else kind.pattern
+
+    @property
+    def sd2_level_function(self) -> str:
+        """The level function the SD-2 pattern's factors come from ("bound" unless given)."""
+        return self.level_function or "bound"

@@ -27,7 +27,7 @@ BYTES_PER_INDEX = 4
 
 
 #: The Tessellation fields a device-resident result reads back on first use.
-HOST_FIELDS = tuple(name for name, _, _ in VERTEX_RECORD) + ("triangles", "factors")
+HOST_FIELDS = tuple(name for name, _, _ in VERTEX_RECORD) + ("triangles", "factors", "real_factors")
 
 
 class StaleOutput(RuntimeError):
@@ -117,6 +117,10 @@ class Tessellation(IndexedMesh):
                 (``device``) has no "read_back" until its arrays are fetched, and "total" then
                 is "stages" + "read_back" (the time the caller spent between is not counted).
     device:     the output on the device (:class:`DeviceOutput`), or None (host arrays only).
+    strips:     (S,) uint32 triangle strips of the strip patterns' patches (SD-2), restart-
+                separated (cltess.strips), or None; they expand to those patches' triangles
+    real_factors: (P, 4) float32 real edge factors where a pattern is fractional (SD-2; there
+                ``factors`` are each edge's segments, the odd ceiling), else None
     """
 
     positions: np.ndarray
@@ -130,13 +134,17 @@ class Tessellation(IndexedMesh):
     stats: dict = field(default_factory=dict)
     wall_ms: dict = field(default_factory=dict)
     device: DeviceOutput | None = field(default=None, repr=False, compare=False)
+    strips: np.ndarray | None = None
+    real_factors: np.ndarray | None = None
 
     @classmethod
-    def on_device(cls, device: DeviceOutput, stage_ms: dict, stats: dict, wall_ms: dict) -> "Tessellation":
+    def on_device(cls, device: DeviceOutput, stage_ms: dict, stats: dict, wall_ms: dict,
+                  strips: np.ndarray | None = None) -> "Tessellation":
         """A result whose host arrays (and factors) are read back from ``device`` when first
-        asked for."""
+        asked for (strips, when a pattern makes them, are host arrays already)."""
         tess = object.__new__(cls)
         tess.stage_ms, tess.stats, tess.wall_ms, tess.device = stage_ms, stats, wall_ms, device
+        tess.strips = strips
         return tess
 
     def __getattr__(self, name):

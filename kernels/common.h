@@ -87,7 +87,59 @@ inline void step_differences(float4 d[4])
 typedef struct {
     int k;
     int f;
+    int fixed;  /* 0: point k of f whole segments at k / f; else a fractional pattern's real factor in
+                 * 16.16 fixed point, f = odd_segments(fixed), points by fractional_location */
 } edge_param;
+
+/* --- fractional factors: D3D11 fractional_odd spacing (docs/sd2.md section 1) ----------------- */
+
+/* 1.0 of the 16.16 fixed-point real factors (cltess.patterns.fractional.FIXED_ONE). */
+#define FIXED_ONE 65536
+
+/* Segments of an edge of real factor fixed / 2^16 (>= 1): the smallest odd number >= it. */
+inline int odd_segments(int fixed)
+{
+    int twice_half = fixed + FIXED_ONE;  /* (r + 1) / 2 in 15.17 fixed point, exactly */
+    return 2 * ((twice_half + 2 * FIXED_ONE - 1) >> 17) - 1;
+}
+
+/* Location from its nearer end of point i < (n + 1) / 2 of an edge of real factor fixed / 2^16:
+ * its place on the floor odd factor lerped to its place on the ceiling one by the fraction of
+ * (r + 1) / 2; past the split point (D3D's splitPointOnFloorHalfTessFactor) a point sits one
+ * index lower on the floor factor, so a new pair of points grows out of one point.  Continuous
+ * in r, k / r at odd whole r.  Mirror: cltess/patterns/fractional.py near_location. */
+inline float fractional_location(int fixed, int i)
+{
+    int twice_half = fixed + FIXED_ONE;  /* (r + 1) / 2 in 15.17 fixed point, exactly */
+    int floor_half = twice_half >> 17, ceil_half = (twice_half + 2 * FIXED_ONE - 1) >> 17;
+    int split = floor_half == ceil_half ? ceil_half + 1
+              : floor_half == 1 ? 0
+              : (((floor_half - 1) - (1 << (31 - (int)clz(floor_half - 1)))) << 1) + 1;  /* remove the MSB */
+    int on_floor = i > split ? i - 1 : i;
+    float a = (float)on_floor / (float)(2 * floor_half - 1);
+    float b = (float)i / (float)(2 * ceil_half - 1);
+    float t = (float)(twice_half & (2 * FIXED_ONE - 1)) * (0.5f / (float)FIXED_ONE);
+    return a + t * (b - a);
+}
+
+/* Where point t of an edge lies, as the fraction from its nearer end (*from_end: the far end,
+ * i.e. the location is 1 - it); a midpoint (2k == f, whole factors only) is 0.5 exactly. */
+inline float edge_near_fraction(edge_param t, int *from_end)
+{
+    int near = min(t.k, t.f - t.k);
+    *from_end = near != t.k;
+    return t.fixed ? fractional_location(t.fixed, near) : (float)near / (float)t.f;
+}
+
+/* The location of point t along its edge, from its start, in [0, 1]. */
+inline float edge_location(edge_param t)
+{
+    if (!t.fixed)
+        return (float)t.k / (float)t.f;
+    int from_end;
+    float near = edge_near_fraction(t, &from_end);
+    return from_end ? 1.0f - near : near;
+}
 
 /* Point t of a cubic boundary curve with controls c, placed symmetrically about the midpoint:
  * de Casteljau from the nearer end, and at the midpoint the commutative (a + b) / 2.  A
@@ -109,7 +161,8 @@ inline float4 boundary_point(const float4 c[4], edge_param t)
             for (int i = 0; i < level; ++i)
                 q[i] = (q[i] + q[i + 1]) * 0.5f;
     } else {
-        float s = (float)min(k, f - k) / (float)f;
+        int from_end;
+        float s = edge_near_fraction(t, &from_end);  /* whole factors: min(k, f - k) / f */
         for (int level = 3; level > 0; --level)
             for (int i = 0; i < level; ++i)
                 q[i] = lerp4(q[i], q[i + 1], s);
@@ -122,7 +175,7 @@ inline float4 boundary_point(const float4 c[4], edge_param t)
 /* Quad (u, v, 0); edges counter-clockwise 0: v=0, 1: u=1, 2: v=1, 3: u=0. */
 inline float3 quad_edge_point(int e, edge_param p)
 {
-    float t = (float)p.k / (float)p.f;
+    float t = edge_location(p);
     return e == 0 ? (float3)(t, 0.0f, 0.0f) : e == 1 ? (float3)(1.0f, t, 0.0f)
          : e == 2 ? (float3)(1.0f - t, 1.0f, 0.0f) : (float3)(0.0f, 1.0f - t, 0.0f);
 }
@@ -131,7 +184,7 @@ inline float3 quad_edge_point(int e, edge_param p)
  * corner e+1 (0: P1->P2, w=0; 1: P2->P3, u=0; 2: P3->P1, v=0). */
 inline float3 tri_edge_point(int e, edge_param p)
 {
-    float t = (float)p.k / (float)p.f, s = (float)(p.f - p.k) / (float)p.f;
+    float t = edge_location(p), s = p.fixed ? 1.0f - t : (float)(p.f - p.k) / (float)p.f;
     return e == 0 ? (float3)(s, t, 0.0f) : e == 1 ? (float3)(0.0f, s, t) : (float3)(t, 0.0f, s);
 }
 

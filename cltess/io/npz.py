@@ -11,12 +11,16 @@ from .writing import atomic_write
 
 #: The array fields of a Tessellation, as stored in an .npz export.
 NPZ_ARRAYS = ("positions", "normals", "uv", "patch_ids", "object_ids", "triangles", "factors")
+#: Stored when present: a strip pattern's strips (cltess.strips convention) and real factors.
+NPZ_OPTIONAL_ARRAYS = ("strips", "real_factors")
 
 
 def write_npz(tess: Tessellation, path: str | os.PathLike) -> None:
     """All arrays of ``tess`` under their field names, plus ``stats_json`` (stats, stage_ms)."""
     meta = {"stats": _jsonable(tess.stats), "stage_ms": _jsonable(tess.stage_ms)}
     arrays = {name: np.asarray(getattr(tess, name)) for name in NPZ_ARRAYS}
+    arrays.update({name: np.asarray(getattr(tess, name)) for name in NPZ_OPTIONAL_ARRAYS
+                   if getattr(tess, name, None) is not None})
     with atomic_write(path, "wb") as handle:
         np.savez(handle, **arrays, stats_json=np.array(json.dumps(meta)))
 
@@ -25,6 +29,7 @@ def load_npz(path: str | os.PathLike) -> Tessellation:
     """Read back a file written by :func:`write_npz`."""
     with np.load(path, allow_pickle=False) as data:
         arrays = {name: data[name] for name in NPZ_ARRAYS}
+        arrays.update({name: data[name] for name in NPZ_OPTIONAL_ARRAYS if name in data})
         meta = json.loads(str(data["stats_json"])) if "stats_json" in data else {}
     return Tessellation(**arrays, stage_ms=meta.get("stage_ms", {}), stats=meta.get("stats", {}))
 

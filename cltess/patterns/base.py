@@ -22,6 +22,9 @@ class Pattern:
                quad_semi_uniform for quads, tri_semi_uniform for triangles).
     dyadic:    it reads dyadic factors 2^p_e: stage 1 rounds the kind's factors up to powers of
                two, capped at 2^max_level (``-D PATTERN_DYADIC``, common.h dyadic_factors).
+    fixed_point: its factors are real, as 16.16 fixed-point integers (cltess.patterns.fractional:
+               an edge's segments odd_segments(f), placed by fractional_odd), made by a level
+               function (cltess.levels) rather than by the kinds' integer stage 1.
     layout:    the NumPy mirror, f -> (uv (V, 2) float64, triangles (T, 3) int64 local indices):
                the ring first, then the interior rows, as the device lays the vertices out.
     """
@@ -35,6 +38,7 @@ class Pattern:
     primitive: str = "triangles"
     family: str = ""
     dyadic: bool = False
+    fixed_point: bool = False
 
     @property
     def defines(self) -> dict:

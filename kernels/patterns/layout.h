@@ -7,11 +7,23 @@
 #define CLTESS_PATTERNS_LAYOUT_H
 #include "common.h"
 
+/* Ring points of edge e: its factor, unless the pattern reads its factors otherwise (a
+ * fractional pattern, patterns/sd2.h: the segments of a fixed-point factor). */
+#ifndef PATTERN_EDGE_POINTS
+#define PATTERN_EDGE_POINTS(f, e) factor_of(f, e)
+#endif
+/* 0: the pattern's rows are not equally spaced, so stage 4 evaluates them directly. */
+#ifndef PATTERN_UNIFORM_ROWS
+#define PATTERN_UNIFORM_ROWS 1
+#endif
+
 inline uint pattern_vertex_count(int4 f)
 {
     if (f.s0 <= 0)
         return 0;
-    uint count = (uint)(f.s0 + f.s1 + f.s2 + f.s3);  /* the ring; unused factor slots are 0 */
+    uint count = 0;  /* the ring */
+    for (int e = 0; e < PATTERN_EDGES; ++e)
+        count += (uint)PATTERN_EDGE_POINTS(f, e);
     int rows = pattern_rows(f);
     for (int j = 1; j <= rows; ++j)
         count += (uint)(pattern_row(f, j) - 1);

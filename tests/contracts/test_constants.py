@@ -7,6 +7,7 @@ import numpy as np
 
 from cltess.backends.opencl.programs import kernel_dir
 from cltess.kinds import base as kinds_base
+from cltess.patterns import fractional
 from cltess.surfaces import bezier, pn
 from cltess.tessellation import BYTES_PER_VERTEX, VERTEX_RECORD, Tessellation
 
@@ -22,7 +23,7 @@ def test_defines_equal_the_python_constants():
     expected = {"NORMAL_SHIFT": bezier.NORMAL_SHIFT, "NORMAL_DEGENERATE": bezier.NORMAL_DEGENERATE,
                 "PN_NORMAL_VANISHES": pn.PN_NORMAL_VANISHES, "FACTOR_SLOTS": kinds_base.FACTOR_SLOTS,
                 "FLAG_SATURATED": kinds_base.FLAG_SATURATED, "FLAG_CULLED": kinds_base.FLAG_CULLED,
-                "FLAG_FOLDED": kinds_base.FLAG_FOLDED}
+                "FLAG_FOLDED": kinds_base.FLAG_FOLDED, "FIXED_ONE": fractional.FIXED_ONE}
     for name, value in expected.items():
         assert name in found, f"kernels/common.h has no #define {name}"
         # The kernels hold float32: the define must be the Python constant rounded to float32.

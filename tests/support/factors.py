@@ -34,8 +34,28 @@ def random_triangle_factors(rng, count, high=40):
     return factors
 
 
+def random_fixed_factors(rng, count, high=40):
+    """(count, 4) 16.16 fixed-point triangle factors (f0, f1, f2, 0) in [1, high]: three
+    different, two equal (each pair), all equal, odd whole numbers, all 1, culled (0)."""
+    from cltess.patterns.fractional import FIXED_ONE, to_fixed
+    factors = np.zeros((count, 4), np.int32)
+    factors[:, :3] = to_fixed(rng.uniform(1.0, high, size=(count, 3)))
+    shape = rng.integers(0, 6, count)
+    for pair in range(3):  # shapes 0-2: edges pair and pair+1 equal
+        equal = shape == pair
+        factors[equal, (pair + 1) % 3] = factors[equal, pair]
+    factors[shape == 3, 1:3] = factors[shape == 3, 0:1]
+    whole = rng.random(count) < 0.2
+    factors[whole, :3] = (2 * (factors[whole, :3] // (2 * FIXED_ONE)) + 1) * FIXED_ONE
+    factors[rng.random(count) < 0.05, :3] = FIXED_ONE
+    factors[rng.random(count) < 0.1] = 0
+    return factors
+
+
 def random_pattern_factors(rng, pattern, count, high=40):
     """Random final factors for a registered pattern (by its domain); a dyadic pattern's rounded
     up to powers of two as stage 1 does (levels up to ceil(log2 high))."""
+    if pattern.fixed_point:
+        return random_fixed_factors(rng, count, high)
     factors = {"quad": random_factors, "tri": random_triangle_factors}[pattern.domain](rng, count, high)
     return dyadic_factors(factors, max_level=30) if pattern.dyadic else factors

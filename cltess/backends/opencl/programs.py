@@ -35,6 +35,13 @@ STAGE_AXES = {
     "silhouette_alpha": (),
     "silhouette_levels": (),
     "silhouette_vertices": ("kind", "pattern"),
+    # strip output, for a pattern with pattern_strips (SD-2; cltess/backends/opencl/strips.py)
+    "strip_counts": ("pattern",),
+    "strip_indices": ("pattern",),
+    # the SD-2 level functions (criteria/level.h; cltess/backends/opencl/level_functions.py)
+    "vertex_levels": ("level",),
+    "vertex_bounds": ("level",),
+    "level_factors": ("level",),
 }
 
 
@@ -47,7 +54,8 @@ def composition(stage: str, kind=None, pattern=None, tolerance=None, crack: str 
     """(headers, defines) of a stage's program: the kind's and pattern's headers (objects with a
     ``header``), the crack policy's header, and the tolerance's and the pattern's ``defines``
     (stage 1 only: ``-D PATTERN_DYADIC`` rounds the factors for a dyadic pattern)."""
-    parts = {"kind": kind and kind.header, "pattern": pattern and pattern.header, "crack": crack}
+    parts = {"kind": kind and kind.header, "pattern": pattern and pattern.header, "crack": crack,
+             "level": "criteria/level.h"}
     headers = tuple(parts[axis] for axis in STAGE_AXES[stage])  # stage 1 also reads the tolerance
     if None in headers:
         raise ValueError(f"stage {stage} needs {', '.join(STAGE_AXES[stage])}")

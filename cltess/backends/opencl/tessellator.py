@@ -36,7 +36,9 @@ from ...patterns.semi_uniform import DEFAULT_MAX_LEVEL, level_histogram
 from ...request import Request
 from ...scene import Scene
 from ...tessellation import BYTES_PER_INDEX, BYTES_PER_VERTEX, VERTEX_RECORD, DeviceOutput, Tessellation
+from .level_functions import level_factors
 from .programs import Programs
+from .strips import emit_strips, strip_offsets, strip_parts
 
 WORK_GROUP = 64  # global sizes are rounded up to this; kernels guard their index
 VERIFY_ORDER = 6  # Tessellator.verify: 28 points per triangle, corners and edges included
@@ -171,10 +173,17 @@ class Tessellator:
         for part in parts:
             events["factors"] += self.stage_factors_of(part.kind, part.data, tolerance, request.max_factor,
                                                        factors, flags, part.base, part.pattern, request.max_level)
+        level_stats = {}
+        for part in parts:  # a fixed-point pattern's factors come from a level function (SD-2)
+            if part.pattern.fixed_point:
+                level_events, level_stats = level_factors(self, scene, request, part, factors)
+                events["factors"] += level_events
         final, events["crack_free"] = self.stage_crack_free(factors, data.groups, out=scratch.get("final"))
         scratch["final"] = final
         vertex_offsets, index_offsets, events["counts"] = self.stage_counts(
             final, [(part.pattern, part.base, part.count) for part in parts], scratch=scratch)
+        strips = strip_offsets(self, final, parts) if strip_parts(parts) else (None, 0, [])
+        events["counts"] += strips[2]
         totals = np.zeros(2, np.uint64)  # the two read-backs, and the flags, waited for at once
         flag_values = np.empty(count, np.int32)
         cl.wait_for_events([
@@ -190,6 +199,7 @@ class Tessellator:
             "vertices": num_vertices,
             "triangles": num_indices // 3,
             **data.stats,
+            **level_stats,
         }
         read_back = {}
         if any(part.pattern.dyadic for part in parts):  # the semi-uniform patches' levels
@@ -197,7 +207,8 @@ class Tessellator:
             stats["patch_levels"] = level_histogram(np.concatenate(
                 [read_back["factors"][p.base:p.base + p.count] for p in parts if p.pattern.dyadic]))
         return Plan(scene.name, count, parts, data.objects, final, vertex_offsets, index_offsets,
-                    num_vertices, num_indices, stats, events, started, request, _host=read_back)
+                    num_vertices, num_indices, stats, events, started, request, _host=read_back,
+                    strip_offsets=strips[0], num_strip_indices=strips[1])
 
     def upload_groups(self, groups, num_patches: int) -> dict:
         """Stage 2's edge groups (cltess.crack.adjacency.EdgeGroups over the P * 4 edge slots)
@@ -274,6 +285,9 @@ class Tessellator:
             events["indices"] += self.stage_indices(
                 plan.factors, plan.vertex_offsets, plan.index_offsets, index_range, (lo, hi),
                 kind=part.pattern, out=arrays["triangles"])[1]
+        strips = None
+        if plan.strip_offsets is not None:
+            strips, events["strips"] = emit_strips(self, plan, first, last)
         self.queue.finish()
         stage_ms = {stage: _span_ms(evs) for stage, evs in events.items() if evs}
         wall_ms = {"stages": (time.perf_counter() - plan.started) * 1e3}
@@ -283,12 +297,12 @@ class Tessellator:
 
         def read_back() -> dict:
             host = buffers.read_back(len(vertices["positions"]), len(arrays["triangles"]))
-            host["factors"] = np.abs(plan.host_factors()[first:last])
+            host["factors"], host["real_factors"] = plan.output_factors(first, last)
             return host
 
         device = DeviceOutput(arrays, self.queue, vertex_range[0], read_back,
                               valid=lambda: buffers.generation == generation)
-        tess = Tessellation.on_device(device, stage_ms, stats, wall_ms)
+        tess = Tessellation.on_device(device, stage_ms, stats, wall_ms, strips)
         if not on_device:
             tess.fetch()
             tess.device = None  # the device buffers go when the caller drops nothing but the host arrays
@@ -639,6 +653,25 @@ class Plan:
     started: float
     request: Request
     _host: dict = field(default_factory=dict)
+    strip_offsets: cl_array.Array | None = None  # strip patterns' (P+1,) strip index offsets
+    num_strip_indices: int = 0
+
+    def output_factors(self, first: int, last: int) -> tuple[np.ndarray, np.ndarray | None]:
+        """(factors (n, 4) int32: each edge's segments, real_factors (n, 4) float32 or None when
+        no pattern is fractional) of patches first .. last-1."""
+        factors = np.abs(self.host_factors()[first:last])
+        fixed = [p for p in self.parts if p.pattern.fixed_point]
+        if not fixed:
+            return factors, None
+        from ...patterns.fractional import FIXED_ONE
+        real, whole = factors.astype(np.float32), factors.copy()
+        for part in fixed:
+            lo, hi = max(first, part.base) - first, min(last, part.base + part.count) - first
+            if lo < hi:
+                rows = factors[lo:hi]
+                real[lo:hi] = rows / np.float32(FIXED_ONE)
+                whole[lo:hi] = np.where(rows > 0, 2 * ((rows + 2 * FIXED_ONE - 1 + FIXED_ONE) >> 17) - 1, 0)
+        return whole, real
 
     def host_factors(self) -> np.ndarray:
         if "factors" not in self._host:

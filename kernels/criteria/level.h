@@ -1,0 +1,50 @@
+/* Level functions of the SD-2 pattern (Amresh and Fünfzig, sections 3.1-3.2; docs/sd2.md
+ * section 2; NumPy mirror cltess/levels.py): a value per welded vertex, and each edge's real
+ * factor from its two ends' values alone, so that the two patches of an edge compute bitwise the
+ * same factor and every triangle has at most two different factors (the two edges at one
+ * vertex, the tip, share it).  Factors are 16.16 fixed point (common.h FIXED_ONE). */
+#ifndef CLTESS_CRITERIA_LEVEL_H
+#define CLTESS_CRITERIA_LEVEL_H
+#include "common.h"
+
+/* Pinned to cltess.levels.LEVEL_FUNCTIONS / DEPTH_MAPS by tests/test_sd2_levels.py. */
+#define LEVEL_DEPTH 1       /* distance to the eye plane, mapped by g1 or g2 */
+#define LEVEL_SILHOUETTE 2  /* front (1) / back (0) facing; a crossed edge gets the high factor */
+#define LEVEL_BOUND 3       /* the largest error-bound factor of the vertex's edges */
+#define LEVEL_MAP_LINEAR 0
+#define LEVEL_MAP_QUADRATIC 1
+
+/* The value of a welded vertex at p with normal n, camera at eye looking along forward. */
+inline float vertex_level(int function, float3 p, float3 n, float3 eye, float3 forward)
+{
+    if (function == LEVEL_DEPTH)
+        return dot3(p - eye, forward);
+    return dot3(n, eye - p) >= 0.0f ? 1.0f : 0.0f;
+}
+
+/* g1 (linear) or g2 (quadratic) of section 3.2: depth d in [near, far] onto [high, low],
+ * clamped outside.  g2 = (high - low) / (near - far)^2 (d - far)^2 + low. */
+inline float depth_factor(float d, int map, float near, float far, float low, float high)
+{
+    float range = far - near;
+    float x = range > 0.0f ? clamp((d - near) / range, 0.0f, 1.0f) : 0.0f;
+    float y = 1.0f - x;
+    return map == LEVEL_MAP_QUADRATIC ? low + (high - low) * (y * y) : high * y + low * x;
+}
+
+inline int fixed_factor(float r) { return max((int)rint(r * (float)FIXED_ONE), FIXED_ONE); }
+
+/* Edge factor (fixed point) from its ends' values a, b (levels, or odd whole bound factors).
+ * depth: g(min(a, b)) = max(g(a), g(b)), g falling; silhouette: high where the classes differ. */
+inline int level_edge_factor(int function, float a, float b, int map, float4 range)
+{
+    float near = range.s0, far = range.s1, low = range.s2, high = range.s3;
+    if (function == LEVEL_DEPTH)
+        return max(fixed_factor(depth_factor(a, map, near, far, low, high)),
+                   fixed_factor(depth_factor(b, map, near, far, low, high)));
+    if (function == LEVEL_SILHOUETTE)
+        return fixed_factor(a != b ? high : low);
+    return (int)fmax(a, b) * FIXED_ONE;
+}
+
+#endif

@@ -1,0 +1,200 @@
+"""SD-2 through the pipeline (issue 13, "What must hold"): device strips against the mirror and
+the closed forms, level functions against their mirror, two-different factors with the tip at
+the equal pair, random fractional factors on closed meshes bitwise watertight without
+T-junctions, the bound-keeping variant within its bound, and no pops along a camera orbit."""
+from types import SimpleNamespace
+
+import numpy as np
+import pyopencl.array as cl_array
+import pytest
+import trimesh
+
+import cltess.backends.opencl.tessellator as tessellator_module
+from cltess.checks import t_junctions
+from cltess.io.camera_path import orbit
+from cltess.levels import level_factors, vertex_bounds, vertex_levels, welded_corners
+from cltess.patterns.fractional import FIXED_ONE, to_fixed
+from cltess.patterns.sd2 import SD2, sd2_counts, sd2_shape, sd2_strip_indices
+from cltess.scene import Camera, Scene
+from cltess.strips import expand_strips
+from support import torus
+from support.factors import random_fixed_factors
+
+
+def icosphere(subdivisions=2):
+    return Scene.from_trimesh(trimesh.creation.icosphere(subdivisions), name="icosphere")
+
+
+CAMERA = Camera(eye=np.array([3.0, 1.0, 0.7]), target=np.zeros(3))
+
+
+def test_device_strips_equal_the_mirror_and_the_closed_forms(tessellator, rng):
+    factors = random_fixed_factors(rng, 500, high=30)
+    count = len(factors)
+    device = cl_array.to_device(tessellator.queue, factors)
+    vertex_offsets, index_offsets, _ = tessellator.stage_counts(device, [(SD2, 0, count)])
+    part = SimpleNamespace(pattern=SD2, base=0, count=count)
+    from cltess.backends.opencl.strips import emit_strips, strip_offsets
+    offsets, total, _ = strip_offsets(tessellator, device, [part])
+    closed = np.array([sd2_counts(f) for f in factors])
+    assert np.array_equal(np.diff(vertex_offsets.get()), closed[:, 0])
+    assert np.array_equal(np.diff(index_offsets.get()), 3 * closed[:, 1])
+    assert np.array_equal(np.diff(offsets.get()), closed[:, 2])
+    plan = SimpleNamespace(num_patches=count, num_strip_indices=total, strip_offsets=offsets, parts=[part],
+                           factors=device, vertex_offsets=vertex_offsets)
+    strips, _ = emit_strips(tessellator, plan, 0, count)
+    firsts = vertex_offsets.get()
+    expected = np.concatenate([np.where(s == 0xFFFFFFFF, s, s + firsts[p])
+                               for p, s in enumerate(sd2_strip_indices(f) for f in factors)])[:-1]
+    assert np.array_equal(strips.astype(np.int64), expected)
+    # a batch in the middle gives the same slice
+    middle, _ = emit_strips(tessellator, plan, 100, 300)
+    host = offsets.get()
+    assert np.array_equal(middle, strips[host[100]:host[300] - 1])
+    # strips expand to exactly the triangle list of stage 5, winding included
+    triangles, _ = tessellator.stage_indices(device, vertex_offsets, index_offsets,
+                                             (0, int(index_offsets[count].get())), (0, count), kind=SD2)
+    assert np.array_equal(expand_strips(strips), triangles.get())
+
+
+def test_level_functions_equal_the_mirror(tessellator):
+    scene = icosphere(2)
+    corners, positions, normals = welded_corners(scene)
+    for function in ("depth", "silhouette", "bound"):
+        plan = tessellator.plan(scene, eps=2e-3, pattern="sd2", level_function=function, camera=CAMERA,
+                                depth_map="quadratic", level_factors=(2.0, 9.0))
+        got = plan.host_factors()[:, :3].astype(np.int64)
+        if function == "bound":
+            stage1 = tessellator.plan(scene, eps=2e-3).host_factors()  # the Filip factors, transition pattern
+            expected = level_factors("bound", corners, vertex_bounds(corners, stage1))
+            assert np.array_equal(got, expected)
+        else:
+            values = vertex_levels(function, positions, normals, CAMERA)
+            near, far = (values.min(), values.max()) if function == "depth" else (0, 1)
+            expected = level_factors(function, corners, values, "quadratic", near, far, 2.0, 9.0)
+            assert np.abs(got - expected).max() <= 2, function  # float32 map against float64
+        assert (got >= 2 * FIXED_ONE).all() and (got <= 9 * FIXED_ONE).all() or function == "bound"
+
+
+def test_random_vertex_values_with_ties_give_two_different_factors(rng):
+    """Any per-vertex scalar (ties included): at most two different factors per triangle, the
+    equal pair meeting at the tip, the corner of the smallest value (depth) / the odd one
+    (silhouette) / the largest bound."""
+    mesh = trimesh.creation.icosphere(3)
+    corners = mesh.faces
+    for trial in range(20):
+        values = rng.integers(0, 6, len(mesh.vertices)).astype(float)  # many ties
+        for function in ("depth", "silhouette", "bound"):
+            v = values if function != "silhouette" else (values > 2).astype(float)
+            v = 2 * v + 1 if function == "bound" else v
+            f = level_factors(function, corners, v, near=0, far=5, low=1, high=9)
+            for tri, fs in zip(corners, f):
+                assert len(set(fs.tolist())) <= 2
+                shape, tip = sd2_shape(fs)
+                if shape == "sd2":
+                    own = v[tri]
+                    if function == "depth":
+                        assert own[tip] == own.min()
+                    elif function == "bound":
+                        assert own[tip] == own.max()
+                    else:
+                        assert (own == own[tip]).sum() == 1  # the odd corner
+
+
+def random_level_factors(monkeypatch, rng, high=64.0):
+    """Stage 1's factors replaced by random real factors in [1, high] per patch edge (three
+    different, mostly), so that stage 2's crack-free max on fixed point makes them agree."""
+    def fake(tess, scene, request, part, factors):
+        host = factors.get()
+        live = host[part.base:part.base + part.count, 0] > 0
+        random = to_fixed(rng.uniform(1.0, high, size=(part.count, 3)))
+        ties = rng.random(part.count) < 0.3
+        random[ties, 1] = random[ties, 0]
+        host[part.base:part.base + part.count, :3] = np.where(live[:, None], random, 0)
+        factors.set(host)
+        return [], {"level_function": "random"}
+    monkeypatch.setattr(tessellator_module, "level_factors", fake)
+
+
+@pytest.mark.parametrize("surface", ["icosphere", "torus"])
+def test_random_fractional_factors_are_watertight_without_t_junctions(tessellator, rng, monkeypatch, surface):
+    scene = icosphere(1) if surface == "icosphere" else Scene.from_trimesh(torus(), name="torus")
+    random_level_factors(monkeypatch, rng, high=64.0 if surface == "icosphere" else 10.0)
+    tess = tessellator.tessellate(scene, eps=1e-3, pattern="sd2")
+    real = tess.real_factors[:, :3]
+    assert real.min() >= 1.0 and real.max() <= 64.0 and len(np.unique(real)) > 100
+    welded = tess.welded()
+    assert welded.stats["welded_boundary_edges"] == 0
+    assert welded.stats["welded_misoriented_edges"] == 0 and welded.stats["welded_nonmanifold_edges"] == 0
+    assert len(t_junctions(tess.positions, tess.triangles, tess.object_ids)) == 0
+    assert np.array_equal(expand_strips(tess.strips), tess.triangles)
+    shapes = {sd2_shape(f)[0] for f in tess.factors[:5]}
+    assert shapes  # (the fallback, fans and grids all occur: the factors are random)
+
+
+def test_bound_variant_keeps_the_bound(tessellator):
+    for scene, eps in ((icosphere(2), 1e-3), (Scene.from_trimesh(torus(), name="torus"), 3e-3)):
+        plan = tessellator.plan(scene, eps=eps, pattern="sd2", level_function="bound")
+        tess = tessellator.emit(plan, 0, plan.num_patches)
+        measured = tessellator.verify(scene, plan, tess)
+        assert 0 < measured["verify_ratio"] <= 1.0, measured
+
+
+def surface_at(tess, samples: np.ndarray) -> np.ndarray:
+    """(P, S, 3) the mesh's points at domain points samples (S, 2) (u, v) of every patch: the
+    triangle of the patch's pattern holding each, interpolated linearly."""
+    tri = tess.triangles.astype(np.int64)
+    patch = tess.patch_ids[tri[:, 0]]
+    a, b, c = (tess.uv[tri[:, k]].astype(np.float64) for k in range(3))
+    e1, e2, q = b - a, c - a, samples[None, :, :] - a[:, None, :]
+    den = e1[:, 0] * e2[:, 1] - e2[:, 0] * e1[:, 1]
+    ok = np.abs(den) > 1e-12
+    den = np.where(ok, den, 1.0)[:, None]
+    l1 = (q[..., 0] * e2[:, None, 1] - e2[:, None, 0] * q[..., 1]) / den
+    l2 = (e1[:, None, 0] * q[..., 1] - q[..., 0] * e1[:, None, 1]) / den
+    l0 = 1 - l1 - l2
+    inside = ok[:, None] & (l0 >= -1e-5) & (l1 >= -1e-5) & (l2 >= -1e-5)
+    p = tess.positions.astype(np.float64)
+    at = l0[..., None] * p[tri[:, 0]][:, None] + l1[..., None] * p[tri[:, 1]][:, None] + l2[..., None] * p[tri[:, 2]][:, None]
+    out = np.full((patch.max() + 1, len(samples), 3), np.nan)
+    t, s = np.nonzero(inside)
+    out[patch[t], s] = at[t, s]
+    assert not np.isnan(out).any()
+    return out
+
+
+SAMPLES = np.array([(i / 7, j / 7) for i in range(8) for j in range(8 - i)]) * 0.9 + 0.03
+
+
+def frame_distances(a, b) -> np.ndarray:
+    """(P,) largest distance between two meshes at the same domain points of each patch (a bound
+    on their Hausdorff distance there)."""
+    return np.linalg.norm(surface_at(a, SAMPLES) - surface_at(b, SAMPLES), axis=2).max(axis=1)
+
+
+def shapes(tess):
+    return [sd2_shape(f) for f in to_fixed(tess.real_factors[:, :3])]
+
+
+def test_no_pops_along_an_orbit(tessellator):
+    """Consecutive frames of a depth-driven LOD: every edge's real factor moves in proportion to
+    the step, and so does the mesh of every patch whose shape (fan and its tip, or grid) stays.
+    (Where a patch's tip moves to another corner, through three equal factors, its inside is
+    triangulated afresh: docs/sd2.md section 5 has the size of that jump, measured.)"""
+    scene = icosphere(1)
+    path = orbit([0, 0, 0], 3.0, 41, sweep_deg=40.0)
+
+    def frame(camera):
+        return tessellator.tessellate(scene, eps=1e-3, pattern="sd2", level_function="depth", camera=camera,
+                                      level_factors=(1.0, 6.0), depth_range=(1.5, 4.5))
+
+    frames = [frame(c) for c in path]
+    factor_steps = [np.abs(b.real_factors - a.real_factors).max() for a, b in zip(frames, frames[1:])]
+    coarse = [np.abs(frames[k + 4].real_factors - frames[k].real_factors).max() for k in range(0, 37, 4)]
+    assert max(factor_steps) <= 0.5 * max(coarse) + 1e-4  # 1 degree steps move factors ~1/4 of 4 degrees
+    kept = [np.array([x == y for x, y in zip(shapes(a), shapes(b))]) for a, b in zip(frames, frames[1:])]
+    fine = max(frame_distances(a, b)[same].max() for (a, b), same in zip(zip(frames, frames[1:]), kept))
+    wide = [frame_distances(frames[k], frames[k + 4]) for k in range(0, 37)]
+    steady = [np.logical_and.reduce(kept[k:k + 4]) for k in range(0, 37)]
+    wide = max(d[s].max() for d, s in zip(wide, steady) if s.any())
+    assert fine < 0.5 * wide, (fine, wide)
