@@ -22,6 +22,10 @@ class Pattern:
                quad_semi_uniform for quads, tri_semi_uniform for triangles).
     dyadic:    it reads dyadic factors 2^p_e: stage 1 rounds the kind's factors up to powers of
                two, capped at 2^max_level (``-D PATTERN_DYADIC``, common.h dyadic_factors).
+    stage1:    its own stage 1 instead of the kind's factors, ``(defines, host)``: stage 1 is
+               built with these ``-D`` defines (``(("PATTERN_ESC", 1),)``), and ``host(patches,
+               tolerance, max_level) -> (records, flags)`` is its NumPy mirror (ESC: the candidate
+               masks; cltess/esc/masks.py).
     layout:    the NumPy mirror, f -> (uv (V, 2) float64, triangles (T, 3) int64 local indices):
                the ring first, then the interior rows, as the device lays the vertices out.
     """
@@ -35,11 +39,12 @@ class Pattern:
     primitive: str = "triangles"
     family: str = ""
     dyadic: bool = False
+    stage1: tuple = ()
 
     @property
     def defines(self) -> dict:
         """What stage 1 is built with for this pattern (-D), besides the tolerance's."""
-        return {"PATTERN_DYADIC": 1} if self.dyadic else {}
+        return {"PATTERN_DYADIC": 1} if self.dyadic else dict(self.stage1[0]) if self.stage1 else {}
 
     def counts(self, factors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(vertex counts (P,), index counts (P,)) of each patch's pattern."""

@@ -324,4 +324,10 @@ def strips(f, collapsed: int = 0) -> np.ndarray:
     return patch_mesh(level, masks, collapsed)[2]
 
 
-ESC = Pattern("esc", "quad", 4, "patterns/esc.h", layout, crack="crack/or_masks.h")
+def _stage1(patches, tolerance, max_level):
+    from ..esc.masks import esc_stage  # noqa: PLC0415 (esc.masks imports this module)
+    return esc_stage(patches, tolerance, max_level)
+
+
+ESC = Pattern("esc", "quad", 4, "patterns/esc.h", layout, crack="crack/or_masks.h",
+              stage1=((("PATTERN_ESC", 1),), _stage1))

@@ -25,7 +25,7 @@ __kernel void vertices(__global const float4 *controls, __global const int4 *fac
 
     __attribute__((opencl_unroll_hint))  /* e constant in each copy: the edge's data in registers */
     for (int e = 0; e < PATTERN_EDGES; ++e)
-        for (int k = 0; k < factor_of(f, e); ++k) {
+        for (int k = 0; k < pattern_ring_count(f, e); ++k) {
             edge_param t = pattern_ring_param(f, e, k);
             float3 x = pattern_edge_point(e, t);
             kind_eval(&patch, x, 0, &normal);  /* the normal; the position is the edge's */
@@ -37,7 +37,7 @@ __kernel void vertices(__global const float4 *controls, __global const int4 *fac
     int rows = pattern_rows(f);
     for (int j = 1; j <= rows; ++j) {
         int steps = pattern_row(f, j);
-        if (forward_differencing) {
+        if (forward_differencing && !PATTERN_DIRECT_ROWS) {  /* patterns/layout.h */
             kind_row row;
             kind_row_begin(&patch, pattern_row_point(f, j, 0), pattern_row_point(f, j, steps), steps, &row);
             for (int i = 1; i < steps; ++i) {

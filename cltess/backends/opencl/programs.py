@@ -96,7 +96,7 @@ class Programs:
     def compose(self, kind, pattern, tolerance) -> None:
         """Build (or find) every stage's program for one (kind, pattern, tolerance) now."""
         for stage in STAGES:
-            self.kernel(stage, kind=kind, pattern=pattern, tolerance=tolerance)
+            self.kernel(stage, kind=kind, pattern=pattern, tolerance=tolerance, crack=pattern.crack)
 
     def build(self, stage: str, headers: tuple, defines: dict) -> cl.Program:
         source, options = program_text(stage, headers, defines)

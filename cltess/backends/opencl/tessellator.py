@@ -140,7 +140,8 @@ class Tessellator:
                                                        factors, flags, part.base, part.pattern, request.max_level)
         groups = scene.prepared(("edge groups", sharp_edges), lambda: merge_edge_groups(
             [(host.groups, part.kind.edges, part.base) for host, part in zip(inputs, parts)], count, FACTOR_SLOTS))
-        final, events["crack_free"] = self.stage_crack_free(factors, groups)
+        crack = next((p.pattern.crack for p in parts if p.pattern.crack != "crack/max.h"), "crack/max.h")
+        final, events["crack_free"] = self.stage_crack_free(factors, groups, crack)
         vertex_offsets, index_offsets, events["counts"] = self.stage_counts(
             final, [(part.pattern, part.base, part.count) for part in parts])
         num_vertices = int(vertex_offsets[count].get())  # the two read-backs
@@ -318,7 +319,7 @@ class Tessellator:
             factors.data, flags.data)
         return [event]
 
-    def stage_crack_free(self, factors, groups):
+    def stage_crack_free(self, factors, groups, crack="crack/max.h"):
         """Stage 2.  factors (P, 4) int32 and edge groups over its P * 4 entries
         (cltess.adjacency, or merge_edge_groups for several kinds) -> (P, 4) int32; the
         groups' collapsed_edges are stored negated (kernels/common.h, patch_factors)."""
@@ -328,7 +329,7 @@ class Tessellator:
             cl_array.to_device(self.queue, a.astype(np.int32))
             for a in (groups.group_of, groups.group_start, groups.members, collapsed))
         final = cl_array.empty(self.queue, factors.shape, np.int32)
-        event = self.programs.kernel("crack_free")(
+        event = self.programs.kernel("crack_free", crack=crack)(
             self.queue, _global_size(edges), None, factors.data, group_of.data, group_start.data,
             members.data, collapsed.data, np.uint32(edges), final.data)
         return final, [event]
