@@ -155,3 +155,16 @@ def test_a_culled_record_has_nothing():
 def test_levels_above_the_record_are_refused():
     with pytest.raises(ValueError, match="level 4"):
         esc.pack(4, np.zeros(33, np.int64))
+
+
+def test_record_constants_equal_the_header():
+    import re
+    from cltess.backends.opencl.programs import kernel_dir
+    text = (kernel_dir() / "patterns" / "esc.h").read_text()
+    found = {}
+    for name, value in re.findall(r"^#define (ESC_[A-Z_]+) (.+)$", text, re.MULTILINE):
+        shifted = re.fullmatch(r"\((\d+) << (\d+)\)", value)
+        found[name] = int(shifted[1]) << int(shifted[2]) if shifted else int(value, 0)
+    assert found == {"ESC_BOUNDARY_BITS": esc.BOUNDARY_BITS, "ESC_REVERSED": esc.REVERSED,
+                     "ESC_INTERIOR_SHIFT": esc.INTERIOR_SHIFT, "ESC_INTERIOR_BITS": esc.INTERIOR_BITS,
+                     "ESC_LEVEL_SHIFT": esc.LEVEL_SHIFT, "ESC_ALIVE": esc.ALIVE, "ESC_MAX_LEVEL": esc.MAX_LEVEL}

@@ -306,21 +306,30 @@ def unpack(record) -> tuple[int, np.ndarray]:
     return level, masks
 
 
-def layout(f, collapsed: int = 0) -> tuple[np.ndarray, np.ndarray]:
-    """The Pattern mirror: (uv (V, 2), triangles (T, 3)) of a record; f[0] <= 0: nothing."""
-    if int(f[0]) <= 0:
+def _collapsed(f) -> tuple[np.ndarray, int]:
+    """(the record's absolute values, bit e for a collapsed edge e: stored negated by stage 2)."""
+    f = np.asarray(f, np.int64)
+    return np.abs(f), int(sum(1 << e for e in range(4) if f[e] < 0))
+
+
+def layout(f) -> tuple[np.ndarray, np.ndarray]:
+    """The Pattern mirror: (uv (V, 2), triangles (T, 3)) of a record (a collapsed edge's slot
+    negated); 0: nothing (culled)."""
+    record, collapsed = _collapsed(f)
+    if record[0] == 0:
         return np.zeros((0, 2)), np.zeros((0, 3), np.int64)
-    level, masks = unpack(f)
+    level, masks = unpack(record)
     points, triangles, _ = patch_mesh(level, masks, collapsed)
     return points / (3.0 * (level + 1)), triangles
 
 
-def strips(f, collapsed: int = 0) -> np.ndarray:
+def strips(f) -> np.ndarray:
     """The record's strips (uint32, restart-separated, local indices); expand_strips(...,
     drop_degenerate=True) gives layout(f)'s triangles."""
-    if int(f[0]) <= 0:
+    record, collapsed = _collapsed(f)
+    if record[0] == 0:
         return np.zeros(0, np.uint32)
-    level, masks = unpack(f)
+    level, masks = unpack(record)
     return patch_mesh(level, masks, collapsed)[2]
 
 
