@@ -9,7 +9,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..crack.adjacency import crack_free_factors, merge_edge_groups
+from ..crack.adjacency import crack_free_factors, merge_edge_groups  # noqa: F401 (re-exported)
+from ..crack.or_masks import policy as crack_policy
 from ..kinds import FACTOR_SLOTS, FLAG_CULLED, FLAG_SATURATED, KINDS
 from ..kinds import kind as kind_named
 from ..patterns import quad_pattern, tri_pattern
@@ -121,6 +122,8 @@ class NumpyBackend:
             pattern = request.pattern_for(kind)
             if pattern.dyadic:  # stage 1's rounding (common.h dyadic_factors)
                 f, fl = dyadic_stage(f, fl, request.max_level)
+            if pattern.stage1:  # the pattern's own stage 1 (ESC: candidate masks)
+                f, fl = pattern.stage1[1](controls, request.tolerance_for(scene), request.max_level)
             parts.append((kind, pattern, base, count, controls))
             inputs.append(host)
             factors.append(f)
@@ -129,7 +132,9 @@ class NumpyBackend:
         factors, flags = np.concatenate(factors), np.concatenate(flags)
         groups = merge_edge_groups([(host.groups, kind.edges, b) for host, (kind, _, b, _, _) in zip(inputs, parts)],
                                    base, FACTOR_SLOTS)
-        final = crack_free_factors(factors, groups.group_of, groups.group_start, groups.members, groups.collapsed_edges)
+        crack = next((p.crack for _, p, _, _, _ in parts if p.crack != "crack/max.h"), "crack/max.h")
+        final = crack_policy(crack)(factors, groups.group_of, groups.group_start, groups.members,
+                                    groups.collapsed_edges)
         vertex_counts, index_counts = np.zeros(base, np.int64), np.zeros(base, np.int64)
         for _, pattern, b, count, _ in parts:
             vertex_counts[b:b + count], index_counts[b:b + count] = pattern.counts(final[b:b + count])

@@ -25,6 +25,10 @@ class Pattern:
     fixed_point: its factors are real, as 16.16 fixed-point integers (cltess.patterns.fractional:
                an edge's segments odd_segments(f), placed by fractional_odd), made by a level
                function (cltess.levels) rather than by the kinds' integer stage 1.
+    stage1:    its own stage 1 instead of the kind's factors, ``(defines, host)``: stage 1 is
+               built with these ``-D`` defines (``(("PATTERN_ESC", 1),)``), and ``host(patches,
+               tolerance, max_level) -> (records, flags)`` is its NumPy mirror (ESC: the candidate
+               masks; cltess/esc/masks.py).
     layout:    the NumPy mirror, f -> (uv (V, 2) float64, triangles (T, 3) int64 local indices):
                the ring first, then the interior rows, as the device lays the vertices out.
     """
@@ -39,11 +43,12 @@ class Pattern:
     family: str = ""
     dyadic: bool = False
     fixed_point: bool = False
+    stage1: tuple = ()
 
     @property
     def defines(self) -> dict:
         """What stage 1 is built with for this pattern (-D), besides the tolerance's."""
-        return {"PATTERN_DYADIC": 1} if self.dyadic else {}
+        return {"PATTERN_DYADIC": 1} if self.dyadic else dict(self.stage1[0]) if self.stage1 else {}
 
     def counts(self, factors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(vertex counts (P,), index counts (P,)) of each patch's pattern."""

@@ -4,7 +4,12 @@
  * all patches, kind after kind).  flags: FLAG_SATURATED (the bound is not met at max_factor, or
  * at 2^max_level), FLAG_CULLED, FLAG_FOLDED (common.h).  Built with -D PATTERN_DYADIC for a
  * dyadic pattern (semi-uniform): the factors are rounded up to 2^p_e here, before the crack-free
- * pass, for every kind alike (common.h dyadic_factors). */
+ * pass, for every kind alike (common.h dyadic_factors).  Built with -D PATTERN_ESC for the ESC
+ * pattern (Bezier patches only): its candidate masks instead (criteria/esc_distance.h). */
+#ifdef PATTERN_ESC
+#include "criteria/esc_distance.h"  /* the pattern's own stage 1: candidate masks (patterns/esc.h) */
+#endif
+
 __kernel void factors(__global const float4 *source, __global float4 *controls, uint num_patches,
                       uint patch_base, float eps, float16 view, float4 frustum, float pixels,
                       float pixel_size, int max_factor, int max_level, __global int4 *factors,
@@ -15,7 +20,11 @@ __kernel void factors(__global const float4 *source, __global float4 *controls, 
         return;
     tolerance_args tol = {eps, view, frustum, pixels, pixel_size};
     int flag = 0;
+#ifdef PATTERN_ESC
+    int4 f = esc_factors(source, p, tol, max_level, &flag);
+#else
     int4 f = kind_factors(source, controls, p, tol, max_factor, &flag);
+#endif
 #ifdef PATTERN_DYADIC
     int saturated = 0;
     f = dyadic_factors(f, max_level, &saturated);

@@ -52,10 +52,27 @@ def random_fixed_factors(rng, count, high=40):
     return factors
 
 
+def random_esc_records(rng, count):
+    """(count, 4) ESC records (cltess/patterns/esc.py): levels 0..3, masks of every density,
+    either stored direction, some culled (0), some with a collapsed edge (negated slot)."""
+    from cltess.patterns.esc import pack
+    records = np.zeros((count, 4), np.int32)
+    for p in range(count):
+        level = int(rng.integers(0, 4))
+        masks = (rng.random((33, 3)) < rng.choice([0.0, 0.3, 0.7, 1.0]))[:, :level] @ (1 << np.arange(level))
+        records[p] = pack(level, masks if level else np.zeros(33, np.int64), tuple(rng.random(4) < 0.5))
+    records[rng.random(count) < 0.1] = 0
+    collapsed = (rng.random(count) < 0.1) & (records[:, 0] > 0)
+    records[collapsed, 0] = -records[collapsed, 0]
+    return records
+
+
 def random_pattern_factors(rng, pattern, count, high=40):
     """Random final factors for a registered pattern (by its domain); a dyadic pattern's rounded
-    up to powers of two as stage 1 does (levels up to ceil(log2 high))."""
+    up to powers of two as stage 1 does (levels up to ceil(log2 high)); ESC's records."""
     if pattern.fixed_point:
         return random_fixed_factors(rng, count, high)
+    if pattern.name == "esc":
+        return random_esc_records(rng, count)
     factors = {"quad": random_factors, "tri": random_triangle_factors}[pattern.domain](rng, count, high)
     return dyadic_factors(factors, max_level=30) if pattern.dyadic else factors

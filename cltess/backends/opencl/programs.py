@@ -114,7 +114,7 @@ class Programs:
     def compose(self, kind, pattern, tolerance) -> None:
         """Build (or find) every stage's program for one (kind, pattern, tolerance) now."""
         for stage in STAGES:
-            self.kernel(stage, kind=kind, pattern=pattern, tolerance=tolerance)
+            self.kernel(stage, kind=kind, pattern=pattern, tolerance=tolerance, crack=pattern.crack)
         if kind.per_patch_constants:  # run once per scene, before stage 1
             self.kernel("constants", kind=kind)
 

@@ -178,7 +178,8 @@ class Tessellator:
             if part.pattern.fixed_point:
                 level_events, level_stats = level_factors(self, scene, request, part, factors)
                 events["factors"] += level_events
-        final, events["crack_free"] = self.stage_crack_free(factors, data.groups, out=scratch.get("final"))
+        crack = next((p.pattern.crack for p in parts if p.pattern.crack != "crack/max.h"), "crack/max.h")
+        final, events["crack_free"] = self.stage_crack_free(factors, data.groups, crack, out=scratch.get("final"))
         scratch["final"] = final
         vertex_offsets, index_offsets, events["counts"] = self.stage_counts(
             final, [(part.pattern, part.base, part.count) for part in parts], scratch=scratch)
@@ -422,7 +423,7 @@ class Tessellator:
             factors.data, flags.data)
         return [event]
 
-    def stage_crack_free(self, factors, groups, out=None):
+    def stage_crack_free(self, factors, groups, crack="crack/max.h", out=None):
         """Stage 2.  factors (P, 4) int32 and edge groups over its P * 4 entries
         (cltess.adjacency, or merge_edge_groups for several kinds; or ``upload_groups`` of them)
         -> (P, 4) int32 (``out`` when given); the groups' collapsed_edges are stored negated
@@ -431,7 +432,7 @@ class Tessellator:
         if not isinstance(groups, dict):
             groups = self.upload_groups(groups, len(factors))
         final = cl_array.empty(self.queue, factors.shape, np.int32) if out is None else out
-        event = self.programs.kernel("crack_free")(
+        event = self.programs.kernel("crack_free", crack=crack)(
             self.queue, _global_size(edges), None, factors.data, groups["group_of"].data,
             groups["group_start"].data, groups["members"].data, groups["collapsed"].data, np.uint32(edges),
             final.data)

@@ -1,0 +1,88 @@
+"""ESC's stage 1 in NumPy float64: the distance test per candidate as bit masks, packed into the
+record of cltess/patterns/esc.py.  Mirror of kernels/criteria/esc_distance.h (docs/esc.md)."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..kinds.base import FLAG_CULLED
+from ..patterns.esc import (BOUNDARY_EDGES, COARSE_EDGES, MAX_LEVEL, PATCH_EDGE_AGAINST, PATCH_EDGE_COARSE,
+                            pack, reverse_bits)
+from ..scene import boundary_curves
+from ..surfaces.bezier import evaluate
+
+
+def edge_reversed(controls: np.ndarray) -> bool:
+    """Whether the canonical direction of an edge with controls (4, 4) (float32 values, as the
+    device sees them) runs against them: c3..c0 lexicographically smaller than c0..c3, comparing
+    c0 with c3, then c1 with c2, by x, y, z, w (criteria/esc_distance.h esc_edge_reversed)."""
+    for k in (0, 1):
+        a, b = controls[k], controls[3 - k]
+        for c in range(4):
+            if a[c] != b[c]:
+                return bool(b[c] < a[c])
+    return False
+
+
+def curve_points(controls: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Projected points of a rational cubic with homogeneous controls (4, 4) at t."""
+    t = np.asarray(t, float)[:, None]
+    s = 1 - t
+    h = s ** 3 * controls[0] + 3 * t * s * s * controls[1] + 3 * t * t * s * controls[2] + t ** 3 * controls[3]
+    return h[:, :3] / h[:, 3:]
+
+
+def chord_bits(points: np.ndarray, level: int, eps: float) -> int:
+    """L bits of a coarse edge from its surface points (L + 2, 3), ends first and last."""
+    n = level + 1
+    bits = 0
+    for k in range(1, n):
+        chord = points[0] * (n - k) / n + points[-1] * k / n
+        if np.linalg.norm(points[k] - chord) > eps:
+            bits |= 1 << (k - 1)
+    return bits
+
+
+def patch_masks(patch: np.ndarray, eps: float, level: int) -> tuple[np.ndarray, tuple]:
+    """(33 masks in canonical directions, per patch edge whether its curve's canonical direction
+    runs against counter-clockwise) of one (4, 4, 4) homogeneous patch."""
+    n, m = level + 1, 3 * (level + 1)
+    masks = np.zeros(33, np.int64)
+    for c, (start, end) in enumerate(COARSE_EDGES):
+        if c in BOUNDARY_EDGES:
+            continue
+        k = np.arange(n + 1)
+        x = (n * start[0] + k * (end[0] - start[0])) / m
+        y = (n * start[1] + k * (end[1] - start[1])) / m
+        masks[c] = chord_bits(evaluate(patch, x, y)[0], level, eps)
+    curves = boundary_curves(patch[None])[0]  # (4 edges, 4 controls, 4), counter-clockwise
+    reversed_edges = []
+    for e in range(4):
+        controls = curves[e]
+        flip = edge_reversed(controls.astype(np.float32))
+        reversed_edges.append(flip)
+        canonical = controls[::-1] if flip else controls
+        points = curve_points(canonical, np.arange(m + 1) / m)
+        canonical_bits = 0
+        for s in range(3):
+            canonical_bits |= chord_bits(points[s * n:s * n + n + 1], level, eps) << (s * level)
+        ccw = reverse_bits(canonical_bits, 3 * level) if flip else canonical_bits
+        for s, c in enumerate(PATCH_EDGE_COARSE[e]):
+            mask = (ccw >> (s * level)) & ((1 << level) - 1)
+            masks[c] = reverse_bits(mask, level) if PATCH_EDGE_AGAINST[e] else mask
+    return masks, tuple(reversed_edges)
+
+
+def esc_stage(patches: np.ndarray, tolerance, max_level: int) -> tuple[np.ndarray, np.ndarray]:
+    """(records (P, 4) int32, flags (P,)) of patches (P, 4, 4, 4) homogeneous for a tolerance
+    (ObjectSpace / ScreenSpace): level min(max_level, 3), masks by the distance test."""
+    patches = np.asarray(patches, np.float64).reshape(-1, 4, 4, 4)
+    points = (patches[..., :3] / patches[..., 3:]).reshape(len(patches), -1, 3)
+    eps, culled = tolerance.reference(points.min(axis=1), points.max(axis=1))
+    level = min(max_level, MAX_LEVEL)
+    records = np.zeros((len(patches), 4), np.int32)
+    for p, patch in enumerate(patches):
+        if not culled[p]:
+            masks, flips = patch_masks(patch, float(eps[p]), level)
+            records[p] = pack(level, masks, flips)
+    flags = np.where(culled, FLAG_CULLED, 0).astype(np.int32)  # no bound to saturate
+    return records, flags

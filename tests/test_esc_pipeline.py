@@ -1,0 +1,132 @@
+"""ESC through the pipeline (--pattern esc): stage 1 masks, the OR crack pass, the device against
+the NumPy mirror, watertightness, monotonicity in eps and the measured error (docs/esc.md)."""
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from cltess.backends.numpy import NumpyBackend
+from cltess.bound import worst_bound_ratio
+from cltess.checks import t_junctions
+from cltess.crack.adjacency import edge_groups
+from cltess.criteria.tolerance import ObjectSpace
+from cltess.esc.masks import esc_stage
+from cltess.io import load_scene
+from cltess.patterns import esc
+from cltess.request import Request
+from cltess.scene import Camera
+from conftest import BOUND_RATIOS
+from support import closed_torus_grid, weld_exact
+
+SCENES = Path(__file__).resolve().parent.parent / "scenes"
+
+
+def test_device_equals_the_mirror_on_the_teacup(tessellator):
+    scene = load_scene(SCENES / "teacup.bez")
+    for eps in (1e-3, 1e-2, 3e-2, 1.0):
+        request = Request.of(eps=eps, pattern="esc")
+        device, host = tessellator.tessellate(scene, request), NumpyBackend().tessellate(scene, request)
+        assert np.array_equal(device.factors, host.factors)
+        assert np.array_equal(device.triangles, host.triangles)
+        assert np.abs(device.uv - host.uv).max() < 1e-6
+        assert np.abs(device.positions - host.positions).max() < 1e-5 * np.abs(host.positions).max()
+    assert len(tessellator.tessellate(scene, eps=1e-6, pattern="esc").triangles) == 288 * scene.num_patches
+    assert len(tessellator.tessellate(scene, eps=1e3, pattern="esc").triangles) <= 18 * scene.num_patches
+
+
+def test_max_level_selects_the_candidate_lattice(tessellator):
+    scene = load_scene(SCENES / "teacup.bez")
+    for level in (0, 1, 2, 3):
+        tess = tessellator.tessellate(scene, eps=1e-6, pattern="esc", max_level=level)
+        assert len(tess.triangles) == 18 * (level + 1) ** 2 * scene.num_patches
+    capped = tessellator.tessellate(scene, eps=1e-6, pattern="esc", max_level=6)
+    assert len(capped.triangles) == 288 * scene.num_patches  # records hold L <= 3
+
+
+def test_boundary_masks_agree_before_the_or(rng):
+    """Both patches at a shared edge store bitwise the same canonical boundary bits (object space),
+    so the OR only matters where tolerances differ; flipped sides store REVERSED."""
+    scene = closed_torus_grid(rng, 6, 4, noise=0.2)
+    groups = edge_groups(scene.patches)
+    for eps in (1e-3, 1e-2, 5e-2):
+        records, _ = esc_stage(scene.patches, ObjectSpace(eps), 3)
+        flat = records.reshape(-1)
+        for g in range(groups.num_groups):
+            members = groups.members[groups.group_start[g]:groups.group_start[g + 1]]
+            if len(members) == 2:
+                a, b = flat[members]
+                assert a & esc.BOUNDARY_BITS == b & esc.BOUNDARY_BITS
+                assert bool(a & esc.REVERSED) == bool(groups.flipped[members[0]])
+                assert bool(b & esc.REVERSED) == bool(groups.flipped[members[1]])
+
+
+def closed_scenes(rng):
+    yield "torus_grid", closed_torus_grid(rng, 8, 5, noise=0.15)
+    yield "sphere", load_scene(SCENES / "sphere.bpt")
+    yield "torus", load_scene(SCENES / "torus.bpt")
+
+
+def assert_closed(tess):
+    mesh = weld_exact(tess.positions, tess.triangles)
+    assert mesh.is_watertight
+    assert mesh.is_winding_consistent
+    assert len(t_junctions(tess.positions, tess.triangles)) == 0
+
+
+def test_closed_scenes_are_watertight_for_random_eps(tessellator, rng):
+    for name, scene in closed_scenes(rng):
+        for eps in 10.0 ** rng.uniform(-4, -1, 3):
+            tess = tessellator.tessellate(scene, eps=float(eps), pattern="esc")
+            assert_closed(tess)
+            BOUND_RATIOS[f"esc {name} eps={eps:.2g}"] = worst_bound_ratio(scene, tess, eps=float(eps),
+                                                                           max_triangles=4000)
+
+
+def test_screen_space_tolerances_differ_and_the_or_closes_them(tessellator, rng):
+    """Pixels: every patch its own eps, so the two sides test a shared edge against different
+    thresholds; the OR pass makes them agree."""
+    scene = closed_torus_grid(rng, 8, 5, noise=0.15)
+    scene.camera = Camera(eye=np.array([0.0, -7.0, 3.0]), target=np.zeros(3), fov_y_deg=60, width=800, height=600)
+    for pixels in (0.5, 2.0, 8.0):
+        request = Request.of(pixels=pixels, pattern="esc")
+        plan = NumpyBackend().plan(scene, request)
+        records, _ = esc_stage(scene.patches, request.tolerance_for(scene), 3)
+        assert not np.array_equal(np.abs(plan.factors), records)  # the OR changed something
+        tess = tessellator.tessellate(scene, request)
+        assert tess.stats["culled"] == 0
+        assert_closed(tess)
+
+
+def test_smaller_eps_never_removes_a_candidate(tessellator, rng):
+    scene = closed_torus_grid(rng, 6, 4, noise=0.2)
+    previous_masks, previous_count = None, None
+    for eps in sorted(10.0 ** rng.uniform(-4, 0, 8), reverse=True):
+        tess = tessellator.tessellate(scene, eps=float(eps), pattern="esc")
+        masks = np.stack([esc.unpack(np.abs(f))[1] for f in tess.factors])
+        if previous_masks is not None:
+            assert ((masks & previous_masks) == previous_masks).all()
+            assert len(tess.triangles) >= previous_count
+        previous_masks, previous_count = masks, len(tess.triangles)
+
+
+def test_strips_of_the_records_expand_to_the_triangles():
+    from cltess.strips import expand_strips
+    tess = NumpyBackend().plan(load_scene(SCENES / "teapot.bez"), Request.of(eps=1e-2, pattern="esc"))
+    for f in tess.factors[16:32]:  # the lid and the bottom: collapsed edges
+        _, triangles = esc.layout(f)
+        strips = esc.strips(f)
+        expanded = expand_strips(strips, drop_degenerate=True)
+        assert sorted(map(tuple, np.sort(expanded, 1))) == sorted(map(tuple, np.sort(triangles, 1)))
+
+
+def test_collapsed_edges_leave_no_triangle_on_them(tessellator):
+    """The teapot's lid and bottom have collapsed edges (poles): ESC leaves out the triangles with
+    a side on them, as the other patterns do, and the device agrees with the mirror."""
+    scene = load_scene(SCENES / "teapot.bez")
+    request = Request.of(eps=1e-2, pattern="esc")
+    device, host = tessellator.tessellate(scene, request), NumpyBackend().tessellate(scene, request)
+    assert edge_groups(scene.patches).collapsed_edges.sum() == 8
+    assert np.array_equal(device.triangles, host.triangles)
+    mesh = weld_exact(device.positions, device.triangles)
+    assert len(mesh.faces) == len(device.triangles)  # no triangle collapsed onto a pole
+    assert mesh.is_winding_consistent
