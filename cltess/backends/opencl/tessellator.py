@@ -246,12 +246,12 @@ class Tessellator:
                 self.queue, _global_size(count), None, controls.data, np.uint32(count), out.data)
             if events is not None:
                 events.setdefault("constants", []).append(event)
-            return out
+            return self.context, out
 
         if scene is None:
-            return make()
-        # The cached array holds this context alive, so its id is not reused while cached.
-        return scene.prepared((kind.name, "constants", id(self.context)), make)
+            return make()[1]
+        # Cached with the context object itself, so that its id is not reused while cached.
+        return scene.prepared((kind.name, "constants", id(self.context)), make)[1]
 
     def emit(self, plan: "Plan", first: int, last: int, forward_differencing: bool | None = None,
              on_device: bool = False, out: "OutputBuffers | None" = None) -> Tessellation:
