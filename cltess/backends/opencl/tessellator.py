@@ -225,6 +225,13 @@ class Tessellator:
         read back to host arrays only when one is asked for; else it is read back now (on a CPU
         device by mapping the buffers: no copy).  out: output buffers to write into (grown as
         needed; a ``Session`` reuses its own), else fresh ones."""
+        return self.emit_async(plan, first, last, forward_differencing, out).result(on_device)
+
+    def emit_async(self, plan: "Plan", first: int, last: int, forward_differencing: bool | None = None,
+                   out: "OutputBuffers | None" = None) -> "PendingEmit":
+        """Enqueue stages 4-5 as ``emit`` does and return at once: ``.result()`` waits for
+        them.  The host may meanwhile do other work, such as writing the previous batch
+        (cltess.stream)."""
         if forward_differencing is None:
             forward_differencing = plan.request.forward_differencing
         vertex_range = plan.vertex_range(first, last)
@@ -245,25 +252,8 @@ class Tessellator:
             events["indices"] += self.stage_indices(
                 plan.factors, plan.vertex_offsets, plan.index_offsets, index_range, (lo, hi),
                 kind=part.pattern, out=arrays["triangles"])[1]
-        self.queue.finish()
-        stage_ms = {stage: _span_ms(evs) for stage, evs in events.items() if evs}
-        wall_ms = {"stages": (time.perf_counter() - plan.started) * 1e3}
-        stage_ms["total_wall"] = wall_ms["stages"]  # until the host arrays are there: Tessellation.fetch
-        stats = dict(plan.stats, first_patch=first, last_patch=last)
-        generation = buffers.generation
-
-        def read_back() -> dict:
-            host = buffers.read_back(len(vertices["positions"]), len(arrays["triangles"]))
-            host["factors"] = np.abs(plan.host_factors()[first:last])
-            return host
-
-        device = DeviceOutput(arrays, self.queue, vertex_range[0], read_back,
-                              valid=lambda: buffers.generation == generation)
-        tess = Tessellation.on_device(device, stage_ms, stats, wall_ms)
-        if not on_device:
-            tess.fetch()
-            tess.device = None  # the device buffers go when the caller drops nothing but the host arrays
-        return tess
+        self.queue.flush()
+        return PendingEmit(self, plan, first, last, vertex_range[0], arrays, events, buffers)
 
     # --- stage 6 on request: the error, measured (issue 9 item 9) ---------------------------------
 
@@ -466,6 +456,45 @@ def combine_verified(parts: list[dict]) -> dict:
     worst = max(parts, key=lambda p: p["verify_ratio"])
     return dict(worst, verify_triangles=sum(p["verify_triangles"] for p in parts),
                 verify_ms=sum(p["verify_ms"] for p in parts))
+
+
+@dataclass
+class PendingEmit:
+    """Stages 4-5 enqueued (``Tessellator.emit_async``); ``result()`` waits and gives the
+    Tessellation."""
+
+    tessellator: "Tessellator"
+    plan: "Plan"
+    first: int
+    last: int
+    vertex_base: int
+    arrays: dict
+    events: dict
+    buffers: "OutputBuffers"
+
+    def result(self, on_device: bool = False) -> Tessellation:
+        plan, first, last, buffers, arrays = self.plan, self.first, self.last, self.buffers, self.arrays
+        all_events = [event for evs in self.events.values() for event in evs]
+        if all_events:
+            cl.wait_for_events(all_events)
+        stage_ms = {stage: _span_ms(evs) for stage, evs in self.events.items() if evs}
+        wall_ms = {"stages": (time.perf_counter() - plan.started) * 1e3}
+        stage_ms["total_wall"] = wall_ms["stages"]  # until the host arrays are there: Tessellation.fetch
+        stats = dict(plan.stats, first_patch=first, last_patch=last)
+        generation = buffers.generation
+
+        def read_back() -> dict:
+            host = buffers.read_back(len(arrays["positions"]), len(arrays["triangles"]))
+            host["factors"] = np.abs(plan.host_factors()[first:last])
+            return host
+
+        device = DeviceOutput(arrays, self.tessellator.queue, self.vertex_base, read_back,
+                              valid=lambda: buffers.generation == generation)
+        tess = Tessellation.on_device(device, stage_ms, stats, wall_ms)
+        if not on_device:
+            tess.fetch()
+            tess.device = None  # the device buffers go when the caller drops nothing but the host arrays
+        return tess
 
 
 class OutputBuffers:
