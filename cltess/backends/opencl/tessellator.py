@@ -239,7 +239,7 @@ class Tessellator:
         events = dict(plan.events) if first == 0 else {}
         buffers = out if out is not None else OutputBuffers(self)
         arrays = buffers.take(vertex_range[1] - vertex_range[0], (index_range[1] - index_range[0]) // 3)
-        vertices = {name: arrays[name] for name, _, _ in VERTEX_RECORD}
+        vertices = {name: arrays.raw(name) for name, _, _ in VERTEX_RECORD}
         events["vertices"], events["indices"] = [], []
         for part in plan.parts:
             lo, hi = max(first, part.base), min(last, part.base + part.count)
@@ -251,7 +251,7 @@ class Tessellator:
                 pattern=part.pattern)[1]
             events["indices"] += self.stage_indices(
                 plan.factors, plan.vertex_offsets, plan.index_offsets, index_range, (lo, hi),
-                kind=part.pattern, out=arrays["triangles"])[1]
+                kind=part.pattern, out=arrays.raw("triangles"))[1]
         self.queue.flush()
         return PendingEmit(self, plan, first, last, vertex_range[0], arrays, events, buffers)
 
@@ -403,8 +403,9 @@ class Tessellator:
         events = [self.programs.kernel("counts", pattern=_pattern(k))(
             self.queue, _global_size(n), None, factors.data, np.uint32(n), np.uint32(base),
             vertex_counts.data, index_counts.data) for k, base, n in ranges if n]
-        events += [self.programs.offsets_scan(vertex_counts, vertex_offsets),
-                   self.programs.offsets_scan(index_counts, index_offsets)]
+        if count:
+            events.append(self.programs.offsets_scan_pair(vertex_counts, index_counts, vertex_offsets, index_offsets,
+                                                          np.uint64(count), size=2 * count))
         return vertex_offsets, index_offsets, events
 
     def _vertex_arrays(self, n: int) -> dict:
@@ -458,6 +459,54 @@ def combine_verified(parts: list[dict]) -> dict:
                 verify_ms=sum(p["verify_ms"] for p in parts))
 
 
+class _Raw:
+    """A buffer where the stage functions expect an array (they read ``.data`` only)."""
+
+    __slots__ = ("data",)
+
+    def __init__(self, data):
+        self.data = data
+
+
+class OutputArrays(dict):
+    """The pyopencl arrays of one output (name -> ``pyopencl.array.Array``, made on first
+    access: a frame whose output nobody looks at on the device does not pay for them)."""
+
+    def __init__(self, queue, layout, buffers: dict, num_vertices: int, num_triangles: int):
+        super().__init__()
+        self.queue, self.layout, self.buffers = queue, {name: (dtype, shape) for name, dtype, shape in layout}, buffers
+        self.num_vertices, self.num_triangles = num_vertices, num_triangles
+
+    def raw(self, name: str) -> _Raw:
+        return _Raw(self.buffers[name])
+
+    def __contains__(self, name) -> bool:
+        return name in self.layout
+
+    def __missing__(self, name):
+        if name not in self.layout:
+            raise KeyError(name)
+        dtype, shape = self.layout[name]
+        rows = self.num_triangles if name == "triangles" else self.num_vertices
+        self[name] = cl_array.Array(self.queue, (rows, *shape), dtype, data=self.buffers[name])
+        return self[name]
+
+    def keys(self):
+        return self.layout.keys()
+
+    def values(self):
+        return [self[name] for name in self.layout]
+
+    def items(self):
+        return [(name, self[name]) for name in self.layout]
+
+    def __iter__(self):
+        return iter(self.layout)
+
+    def __len__(self) -> int:
+        return len(self.layout)
+
+
 @dataclass
 class PendingEmit:
     """Stages 4-5 enqueued (``Tessellator.emit_async``); ``result()`` waits and gives the
@@ -484,7 +533,7 @@ class PendingEmit:
         generation = buffers.generation
 
         def read_back() -> dict:
-            host = buffers.read_back(len(arrays["positions"]), len(arrays["triangles"]))
+            host = buffers.read_back(arrays.num_vertices, arrays.num_triangles)
             host["factors"] = np.abs(plan.host_factors()[first:last])
             return host
 
@@ -538,8 +587,8 @@ class OutputBuffers:
         self.generation += 1
         self.unmap()
         flags = cl.mem_flags.READ_WRITE | (cl.mem_flags.ALLOC_HOST_PTR if self.mapped else 0)
-        arrays = {}
-        for name, dtype, shape in self._layout():
+        layout = self._layout()
+        for name, dtype, shape in layout:
             rows = num_triangles if name == "triangles" else num_vertices
             row_bytes = dtype.itemsize * int(np.prod(shape))
             buffer, capacity = self._buffers.get(name, (None, -1))
@@ -549,8 +598,8 @@ class OutputBuffers:
                 self._staging.pop(name, None)
                 buffer = cl.Buffer(self.context, flags, max(capacity, 1) * row_bytes)
                 self._buffers[name] = (buffer, capacity)
-            arrays[name] = cl_array.Array(self.queue, (rows, *shape), dtype, data=buffer)
-        return arrays
+        return OutputArrays(self.queue, layout, {name: self._buffers[name][0] for name, _, _ in layout},
+                            num_vertices, num_triangles)
 
     def read_back(self, num_vertices: int, num_triangles: int) -> dict:
         """The current generation's output as host arrays (see the class)."""
