@@ -10,8 +10,9 @@ On one OpenCL device, in this order, every figure a median (or the best, where s
    NumPy array: the read-back bandwidths, best of 3 (wall clock).
 2. **Uniform level 16.** 1,000 teapots (32,000 patches), every edge factor 16 (``max_factor``
    16, a tolerance every patch misses): 580 MB of output.  Device time of the five stages
-   through a ``Session`` (output buffers reused) and through one-shot ``Tessellator.tessellate``
-   (fresh buffers); output bytes / device time as a fraction of the fill bandwidth; the
+   through a ``Session`` (output buffers reused), the same with stage 4 a work-item per
+   (patch, row) (``Tessellator(rows_in_parallel=True)``, stages/vertex_rows.cl), and through
+   one-shot ``Tessellator.tessellate`` (fresh buffers); output bytes / device time as a fraction of the fill bandwidth; the
    session's read-back (``fetch``) rate against the page-locked bandwidth.
 3. **Frame loop on the paper's scenes** (``cltess bench``'s suite, 0.5 px): a ``Session``
    follows ``--frames`` cameras on a circle around each scene's camera target.  Per frame:
@@ -201,7 +202,18 @@ def uniform(tessellator, scene, factor: int, repeat: int, band: dict) -> dict:
         one_shot.append((device_ms(tess), tess.wall_ms["total"]))
         del tess
     read_back = statistics.median(fetched)
-    return {"patches": scene.num_patches, "factor": factor, "triangles": first.num_triangles, "bytes": size,
+    tessellator.rows_in_parallel = True  # stage 4 a work-item per (patch, row): stages/vertex_rows.cl
+    try:
+        rows_session = cltess.Session(scene, tessellator=tessellator, **uniform_request(factor))
+        rows_session.tessellate()
+        rows = [rows_session.tessellate() for _ in range(repeat)]
+        rows_ms = {stage: statistics.median(r.stage_ms[stage] for r in rows) for stage in ("vertices", "indices")}
+        rows_device = statistics.median(device_ms(r) for r in rows)
+        del rows, rows_session
+    finally:
+        tessellator.rows_in_parallel = False
+    return {"rows_device_ms": rows_device, "rows_vertices_ms": rows_ms["vertices"],
+            "patches": scene.num_patches, "factor": factor, "triangles": first.num_triangles, "bytes": size,
             "stage_ms": stage_ms, "device_ms": device,
             "vertices_indices_ms": stage_ms.get("vertices", 0) + stage_ms.get("indices", 0),
             "fraction_of_fill": size / (device / 1e3) / band["fill_bytes_per_s"],
@@ -305,6 +317,9 @@ def report(record: dict) -> str:
     size = level["bytes"]
     for label, ms in (("device, stages 1-5 (session)", level["device_ms"]),
                       ("device, stages 4-5 (session)", level["vertices_indices_ms"]),
+                      ("device, stage 4 alone (session)", level["stage_ms"].get("vertices", 0.0)),
+                      ("device, stages 1-5, stage 4 a work-item per row (session)", level["rows_device_ms"]),
+                      ("device, stage 4 alone, a work-item per row (session)", level["rows_vertices_ms"]),
                       ("device, stages 1-5 (one-shot, fresh buffers)", level["one_shot_device_ms"]),
                       ("one-shot end to end, host arrays", level["one_shot_total_ms"]),
                       ("session read-back (fetch)", level["read_back_ms"])):

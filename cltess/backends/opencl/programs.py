@@ -28,6 +28,7 @@ STAGE_AXES = {
     "indices": ("pattern",),
     # stage 4 by level (levels.py), for a pattern with a template: built when it is asked for
     "level_vertices": ("kind", "pattern"),
+    "vertex_rows": ("kind", "pattern"),  # stage 4 a work-item per row (Tessellator(rows_in_parallel=True))
     "verify": ("kind",),  # on request only (Tessellator.verify), so not in STAGES
 }
 

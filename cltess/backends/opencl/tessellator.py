@@ -39,6 +39,9 @@ from ...tessellation import BYTES_PER_INDEX, BYTES_PER_VERTEX, VERTEX_RECORD, De
 from .programs import Programs
 
 WORK_GROUP = 64  # global sizes are rounded up to this; kernels guard their index
+#: stages/vertex_rows.cl: work-items per patch (the ring and 64 rows; a patch with more rows has
+#: its last work-item do the rest, so this is a speed setting, never a limit).
+MAX_ROWS_PER_PATCH = 65
 VERIFY_ORDER = 6  # Tessellator.verify: 28 points per triangle, corners and edges included
 VERIFY_MAX_TRIANGLES = 4_000_000  # above this, every k-th triangle is verified
 
@@ -80,7 +83,11 @@ class Tessellator:
 
     name = "opencl"
 
-    def __init__(self, device: cl.Device | str | None = None):
+    def __init__(self, device: cl.Device | str | None = None, rows_in_parallel: bool = False):
+        """rows_in_parallel: stage 4 with a work-item per (patch, row) (stages/vertex_rows.cl,
+        bitwise the same output) rather than per patch: more parallelism for a GPU; off by
+        default until measured there (bench/frame_loop.py times both)."""
+        self.rows_in_parallel = rows_in_parallel
         self.device = device if isinstance(device, cl.Device) else pick_device(device)
         self.context = cl.Context([self.device])
         self.queue = cl.CommandQueue(self.context, properties=cl.command_queue_properties.PROFILING_ENABLE)
@@ -414,21 +421,32 @@ class Tessellator:
 
     def stage_vertices(self, controls, factors, vertex_offsets, patch_objects, vertex_range,
                        patch_range, forward_differencing=True, kind=BEZIER, patch_base=0, out=None,
-                       pattern=None):
+                       pattern=None, rows_per_patch: int | None = None):
         """Stage 4 for patches patch_range = (first, last) (scene numbers, all of one kind whose
         first patch is patch_base; controls: that kind's stage-4 input, Bézier patches or PN
         control points), whose vertices are vertex_range = (start, stop) -> dict of positions
         (V, 3), normals (V, 3), uv (V, 2), patch_ids (V,), object_ids (V,) device arrays,
-        V = stop - start (written into ``out`` when given), and the events."""
+        V = stop - start (written into ``out`` when given), and the events.  rows_per_patch:
+        work-items per patch of stages/vertex_rows.cl (0: one per patch, stages/vertices.cl;
+        None: as the Tessellator's ``rows_in_parallel``, with ``MAX_ROWS_PER_PATCH``)."""
         out = self._vertex_arrays(vertex_range[1] - vertex_range[0]) if out is None else out
         first, last = patch_range
         if vertex_range[1] == vertex_range[0] or last <= first:
             return out, []
         kind = kind_named(kind)
-        event = self.programs.kernel("vertices", kind=kind, pattern=pattern or kind.pattern)(
-            self.queue, _global_size(last - first), None, controls.data, factors.data, vertex_offsets.data,
-            patch_objects.data, np.uint32(first), np.uint32(last - first), np.uint32(patch_base),
-            np.uint64(vertex_range[0]), np.int32(forward_differencing), *(a.data for a in out.values()))
+        pattern = pattern or kind.pattern
+        arguments = (controls.data, factors.data, vertex_offsets.data, patch_objects.data, np.uint32(first),
+                     np.uint32(last - first), np.uint32(patch_base), np.uint64(vertex_range[0]),
+                     np.int32(forward_differencing))
+        if rows_per_patch is None and self.rows_in_parallel:
+            rows_per_patch = MAX_ROWS_PER_PATCH
+        if rows_per_patch:
+            event = self.programs.kernel("vertex_rows", kind=kind, pattern=pattern)(
+                self.queue, _global_size((last - first) * rows_per_patch), None, *arguments,
+                np.uint32(rows_per_patch), *(a.data for a in out.values()))
+        else:
+            event = self.programs.kernel("vertices", kind=kind, pattern=pattern)(
+                self.queue, _global_size(last - first), None, *arguments, *(a.data for a in out.values()))
         return out, [event]
 
     def stage_indices(self, factors, vertex_offsets, index_offsets, index_range, patch_range,
