@@ -6,9 +6,14 @@ output fits the budget; each batch runs stages 4-5 (``Tessellator.emit``) and is
 streaming PLY or OBJ writer.  The file is the same, byte for byte, as a single pass would
 write, and it appears only when complete (``io.writing.atomic_write``).
 
-Memory: a batch's output lives three times at once at most (the device buffers, their host
-copy, the writer's records), so batches are sized to a third of the budget; on a CPU device the
-"device" buffers are host memory too.
+Memory: batches are sized to a third of the budget.  Two batches' output buffers are alive at
+once (``_overlapped``: the device computes batch k+1 while the host writes batch k), and on a
+GPU their two page-locked host copies; on a CPU device the buffers are mapped, so the host
+arrays are the device buffers themselves.  The writer builds its records in 10 MB chunks.
+Between them at most 2 of the 3 thirds of the budget, plus the chunks.
+
+on_batch gets each batch as it is written: its arrays are views of buffers that batch k+2
+reuses, so copy what must outlive the call.
 """
 from __future__ import annotations
 
@@ -94,21 +99,64 @@ def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = 
     stage_ms: dict = {}
     done, verified = [], []
     with STREAMING_WRITERS[extension](path, plan.num_vertices, plan.num_indices // 3) as writer:
-        for first, last in ranges:
-            for batch in _emit_fitting(tessellator, plan, first, last, forward_differencing):
-                writer.write_vertices(batch)
-                writer.write_faces(batch.triangles)
-                if on_batch is not None:
-                    on_batch(batch)
-                done.append((batch.stats["first_patch"], batch.stats["last_patch"]))
-                if progress is not None:
-                    progress("batches", batch.stats["last_patch"], plan.num_patches)
-                if verify:
-                    verified.append(tessellator.verify(scene, plan, batch))
-                for stage, ms in batch.stage_ms.items():
-                    stage_ms[stage] = ms if stage == "total_wall" else stage_ms.get(stage, 0.0) + ms
-                del batch
+        for batch in _overlapped(tessellator, plan, ranges, forward_differencing):
+            writer.write_vertices(batch)
+            writer.write_faces(batch.triangles)
+            if on_batch is not None:
+                on_batch(batch)
+            done.append((batch.stats["first_patch"], batch.stats["last_patch"]))
+            if progress is not None:
+                progress("batches", batch.stats["last_patch"], plan.num_patches)
+            if verify:
+                verified.append(tessellator.verify(scene, plan, batch))
+            for stage, ms in batch.stage_ms.items():
+                stage_ms[stage] = ms if stage == "total_wall" else stage_ms.get(stage, 0.0) + ms
+            del batch
     return StreamResult(dict(plan.stats, **combine_verified(verified)), stage_ms, len(done), budget, path, done)
+
+
+def _overlapped(tessellator, plan, ranges, forward_differencing: bool):
+    """The batches' Tessellations in order, batch k+1's stages 4-5 enqueued before batch k is
+    handed out, so the device computes it while the host writes batch k.  Two sets of output
+    buffers take turns (``OutputBuffers``: reused, so allocated and first touched once; on a
+    GPU read back through page-locked memory).  A batch the device has no memory for is
+    split in two (``_emit_fitting``)."""
+    from .backends.opencl.tessellator import OutputBuffers
+
+    if not hasattr(tessellator, "emit_async"):  # another backend: one batch after the other
+        for first, last in ranges:
+            yield from _emit_fitting(tessellator, plan, first, last, forward_differencing)
+        return
+    buffers = [OutputBuffers(tessellator, pinned=len(ranges) > 1) for _ in range(min(2, len(ranges)))]
+
+    def start(k, first, last):
+        try:
+            return tessellator.emit_async(plan, first, last, forward_differencing, out=buffers[k % 2])
+        except (cl.MemoryError, cl.RuntimeError) as error:
+            if not _out_of_memory(error):
+                raise
+            return None
+
+    def finish(first, last, job):
+        if job is not None:
+            try:
+                batch = job.result()
+            except (cl.MemoryError, cl.RuntimeError) as error:
+                if not _out_of_memory(error):
+                    raise
+            else:
+                yield batch
+                return
+        yield from _emit_fitting(tessellator, plan, first, last, forward_differencing)  # in halves if need be
+
+    pending = None
+    for k, (first, last) in enumerate(ranges):
+        upcoming = (first, last, start(k, first, last))
+        if pending is not None:
+            yield from finish(*pending)
+        pending = upcoming
+    if pending is not None:
+        yield from finish(*pending)
 
 
 def _emit_fitting(tessellator, plan, first: int, last: int, forward_differencing: bool):

@@ -69,11 +69,11 @@ class DeviceOutput:
 
     @property
     def num_vertices(self) -> int:
-        return int(self.arrays["positions"].shape[0])
+        return int(getattr(self.arrays, "num_vertices", None) or self.arrays["positions"].shape[0])
 
     @property
     def num_triangles(self) -> int:
-        return int(self.arrays["triangles"].shape[0])
+        return int(getattr(self.arrays, "num_triangles", None) or self.arrays["triangles"].shape[0])
 
     @property
     def nbytes(self) -> int:

@@ -305,6 +305,11 @@ BATCHED = {"many_patches_batched": ("many_patches", 4096)}
 BY_LEVEL = {"semi_uniform_by_level": "semi_uniform",
             "pn_semi_uniform_mixed_culled_by_level": "pn_semi_uniform_mixed_culled"}
 
+#: Scenarios whose stage 4 runs a work-item per (patch, row) (stages/vertex_rows.cl), with 3
+#: work-items per patch so that the last one does the remaining rows too.
+ROWS_IN_PARALLEL = {"many_patches_by_rows": "many_patches", "pn_icosphere_by_rows": "pn_icosphere",
+                    "semi_uniform_by_rows": "semi_uniform", "collapsed_bottom_direct_by_rows": "collapsed_bottom_direct"}
+
 
 # --------------------------------------------------------------------------- self-tests
 
@@ -383,6 +388,17 @@ def run_scenario(name: str, tessellator, out_dir: Path) -> dict:
 
         scene, options = SCENARIOS[BY_LEVEL[name]]()
         tess = emit_by_level(tessellator, plan_by_level(tessellator, scene, Request.of(**options)))
+    elif name in ROWS_IN_PARALLEL:
+        from cltess.backends.opencl import tessellator as opencl
+
+        scene, options = SCENARIOS[ROWS_IN_PARALLEL[name]]()
+        plan = tessellator.plan(scene, **options)
+        saved = tessellator.rows_in_parallel, opencl.MAX_ROWS_PER_PATCH
+        tessellator.rows_in_parallel, opencl.MAX_ROWS_PER_PATCH = True, 3
+        try:
+            tess = tessellator.emit(plan, 0, plan.num_patches)
+        finally:
+            tessellator.rows_in_parallel, opencl.MAX_ROWS_PER_PATCH = saved
     else:
         scene, options = SCENARIOS[name]()
         plan = tessellator.plan(scene, **options)

@@ -83,3 +83,28 @@ def test_bez_fast_path_takes_only_what_the_slow_parser_takes(token, where):
     if fast is None:
         return
     assert fast.tobytes() == slow_bez(text).tobytes()
+
+
+def test_the_scene_cache_gives_the_parsed_patches_back(tmp_path, rng, monkeypatch):
+    from cltess.io import scene_cache
+
+    cache = tmp_path / "cache"
+    monkeypatch.setenv("CLTESS_SCENE_CACHE", str(cache))
+    monkeypatch.setattr(scene_cache, "MIN_BYTES", 0)
+    path = tmp_path / "p.bpt"
+    bpt.write(path, random_patches(rng, 20, True))
+    first = bpt.read(path).patches
+    (entry,) = cache.iterdir()
+    assert bpt.read(path).patches.tobytes() == first.tobytes()  # from the cache
+    entry.write_bytes(b"not an npy file")  # a broken entry: parsed again, and stored again
+    assert bpt.read(path).patches.tobytes() == first.tobytes()
+    assert np.load(entry).tobytes() == np.asarray(first, np.float64).tobytes()
+    bpt.write(path, random_patches(rng, 20, False))  # another file: another entry
+    assert bpt.read(path).patches.tobytes() != first.tobytes() and len(list(cache.iterdir())) == 2
+    path.write_text(path.read_text().replace("3 3", "2 3", 1))  # an error is reported, never cached
+    for _ in range(2):
+        with pytest.raises(SceneError, match="line 2"):
+            bpt.read(path)
+    assert len(list(cache.iterdir())) == 2
+    monkeypatch.setenv("CLTESS_SCENE_CACHE", "off")
+    assert scene_cache.cache_folder() is None

@@ -35,7 +35,7 @@ from cltess.device import list_devices
 from cltess.io.npz import load_npz
 
 HERE = Path(__file__).resolve().parent
-NAMES = [*scenarios.SCENARIOS, *scenarios.BATCHED, *scenarios.BY_LEVEL]
+NAMES = [*scenarios.SCENARIOS, *scenarios.BATCHED, *scenarios.BY_LEVEL, *scenarios.ROWS_IN_PARALLEL]
 
 PASSES = {
     "checks": dict(env=scenarios.OCLGRIND_ENV, args=[],

@@ -88,7 +88,16 @@ def test_out_of_memory_on_the_device_retries_smaller_batches(tessellator, tmp_pa
                                  "simulated")
         return real_emit(plan, first, last, forward_differencing)
 
+    real_emit_async = tessellator.emit_async
+
+    def emit_async(plan, first, last, forward_differencing=True, out=None):
+        if last - first > 4:
+            failed.append((first, last))
+            raise cl.MemoryError("clCreateBuffer", cl.status_code.MEM_OBJECT_ALLOCATION_FAILURE, "simulated")
+        return real_emit_async(plan, first, last, forward_differencing, out)
+
     monkeypatch.setattr(tessellator, "emit", emit)
+    monkeypatch.setattr(tessellator, "emit_async", emit_async)
     result = tessellate_to_file(tessellator, scene, tmp_path / "a.ply", eps=0.01)
     monkeypatch.undo()
     tessellate_to_file(tessellator, scene, tmp_path / "b.ply", eps=0.01)

@@ -9,6 +9,7 @@ import numpy as np
 
 from ..limits import float32_problem
 from ..scene import Scene
+from .scene_cache import cached_patches
 from .text import (_FLOAT_TOKEN, _INDEX_BLOCK_BAD, _INT_TOKEN, _byte_set, _cartesian_rows, _clamped_int, _decode,
                    _floats, _homogeneous, _Lines, _Numbers, _read_bytes)
 
@@ -17,9 +18,14 @@ _INDEX_LINE_BYTES = _byte_set(b"0123456789, \t\n")
 def read_bez(path) -> Scene:
     """An indexed ``.bez`` file as a single-object scene (object id 0)."""
     data = _read_bytes(path)
-    patches = _fast_bez(data)
-    if patches is None:  # something to report, or unusual: line by line, naming the line
-        patches = _parse_bez(_Lines(str(path), _decode(path, data)))
+
+    def parse(data):
+        patches = _fast_bez(data)
+        if patches is None:  # something to report, or unusual: line by line, naming the line
+            patches = _parse_bez(_Lines(str(path), _decode(path, data)))
+        return patches
+
+    patches = cached_patches(data, "bez", parse)
     return Scene(patches, np.zeros(len(patches), np.int32), None, str(path))
 
 

@@ -10,6 +10,7 @@ import numpy as np
 
 from ..limits import float32_problem
 from ..scene import Scene
+from .scene_cache import cached_patches
 from .text import _cartesian_rows, _decode, _floats, _homogeneous, _Lines, _Numbers, _read_bytes
 
 _BPT_LINES_PER_PATCH = 17  # "3 3" + 16 points
@@ -17,9 +18,14 @@ _BPT_LINES_PER_PATCH = 17  # "3 3" + 16 points
 def read_bpt(path) -> Scene:
     """A ``.bpt`` file as a single-object scene (object id 0)."""
     data = _read_bytes(path)
-    patches = _fast_bpt(data)
-    if patches is None:  # something to report, or unusual: line by line, naming the line
-        patches = _parse_bpt(_Lines(str(path), _decode(path, data)))
+
+    def parse(data):
+        patches = _fast_bpt(data)
+        if patches is None:  # something to report, or unusual: line by line, naming the line
+            patches = _parse_bpt(_Lines(str(path), _decode(path, data)))
+        return patches
+
+    patches = cached_patches(data, "bpt", parse)
     return Scene(patches, np.zeros(len(patches), np.int32), None, str(path))
 
 

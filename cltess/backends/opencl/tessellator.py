@@ -41,6 +41,9 @@ from .programs import Programs
 from .strips import emit_strips, strip_offsets, strip_parts
 
 WORK_GROUP = 64  # global sizes are rounded up to this; kernels guard their index
+#: stages/vertex_rows.cl: work-items per patch (the ring and 64 rows; a patch with more rows has
+#: its last work-item do the rest, so this is a speed setting, never a limit).
+MAX_ROWS_PER_PATCH = 65
 VERIFY_ORDER = 6  # Tessellator.verify: 28 points per triangle, corners and edges included
 VERIFY_MAX_TRIANGLES = 4_000_000  # above this, every k-th triangle is verified
 
@@ -82,7 +85,11 @@ class Tessellator:
 
     name = "opencl"
 
-    def __init__(self, device: cl.Device | str | None = None):
+    def __init__(self, device: cl.Device | str | None = None, rows_in_parallel: bool = False):
+        """rows_in_parallel: stage 4 with a work-item per (patch, row) (stages/vertex_rows.cl,
+        bitwise the same output) rather than per patch: more parallelism for a GPU; off by
+        default until measured there (bench/frame_loop.py times both)."""
+        self.rows_in_parallel = rows_in_parallel
         self.device = device if isinstance(device, cl.Device) else pick_device(device)
         self.context = cl.Context([self.device])
         self.queue = cl.CommandQueue(self.context, properties=cl.command_queue_properties.PROFILING_ENABLE)
@@ -263,9 +270,17 @@ class Tessellator:
         device by mapping the buffers: no copy).  out: output buffers to write into (grown as
         needed; a ``Session`` reuses its own), else fresh ones.  A request with emit="by_level"
         runs them by level (levels.emit_by_level, without forward differencing, read back now)."""
+        return self.emit_async(plan, first, last, forward_differencing, out).result(on_device)
+
+    def emit_async(self, plan: "Plan", first: int, last: int, forward_differencing: bool | None = None,
+                   out: "OutputBuffers | None" = None) -> "PendingEmit":
+        """Enqueue stages 4-5 as ``emit`` does and return at once: ``.result()`` waits for
+        them.  The host may meanwhile do other work, such as writing the previous batch
+        (cltess.stream).  A strip pattern's strips are read back here (strips.emit_strips); a
+        request with emit="by_level" runs at once (levels.emit_by_level, read back)."""
         if plan.request.emit == "by_level":  # the semi-uniform parts from per-level templates
             from .levels import emit_by_level
-            return emit_by_level(self, plan, first, last)
+            return _Ready(emit_by_level(self, plan, first, last))
         if forward_differencing is None:
             forward_differencing = plan.request.forward_differencing
         vertex_range = plan.vertex_range(first, last)
@@ -273,7 +288,7 @@ class Tessellator:
         events = dict(plan.events) if first == 0 else {}
         buffers = out if out is not None else OutputBuffers(self)
         arrays = buffers.take(vertex_range[1] - vertex_range[0], (index_range[1] - index_range[0]) // 3)
-        vertices = {name: arrays[name] for name, _, _ in VERTEX_RECORD}
+        vertices = {name: arrays.raw(name) for name, _, _ in VERTEX_RECORD}
         events["vertices"], events["indices"] = [], []
         for part in plan.parts:
             lo, hi = max(first, part.base), min(last, part.base + part.count)
@@ -285,29 +300,12 @@ class Tessellator:
                 pattern=part.pattern)[1]
             events["indices"] += self.stage_indices(
                 plan.factors, plan.vertex_offsets, plan.index_offsets, index_range, (lo, hi),
-                kind=part.pattern, out=arrays["triangles"])[1]
+                kind=part.pattern, out=arrays.raw("triangles"))[1]
         strips = None
         if plan.strip_offsets is not None:
             strips, events["strips"] = emit_strips(self, plan, first, last)
-        self.queue.finish()
-        stage_ms = {stage: _span_ms(evs) for stage, evs in events.items() if evs}
-        wall_ms = {"stages": (time.perf_counter() - plan.started) * 1e3}
-        stage_ms["total_wall"] = wall_ms["stages"]  # until the host arrays are there: Tessellation.fetch
-        stats = dict(plan.stats, first_patch=first, last_patch=last)
-        generation = buffers.generation
-
-        def read_back() -> dict:
-            host = buffers.read_back(len(vertices["positions"]), len(arrays["triangles"]))
-            host["factors"], host["real_factors"] = plan.output_factors(first, last)
-            return host
-
-        device = DeviceOutput(arrays, self.queue, vertex_range[0], read_back,
-                              valid=lambda: buffers.generation == generation)
-        tess = Tessellation.on_device(device, stage_ms, stats, wall_ms, strips)
-        if not on_device:
-            tess.fetch()
-            tess.device = None  # the device buffers go when the caller drops nothing but the host arrays
-        return tess
+        self.queue.flush()
+        return PendingEmit(self, plan, first, last, vertex_range[0], arrays, events, buffers, strips)
 
     # --- stage 6 on request: the error, measured (issue 9 item 9) ---------------------------------
 
@@ -457,8 +455,9 @@ class Tessellator:
         events = [self.programs.kernel("counts", pattern=_pattern(k))(
             self.queue, _global_size(n), None, factors.data, np.uint32(n), np.uint32(base),
             vertex_counts.data, index_counts.data) for k, base, n in ranges if n]
-        events += [self.programs.offsets_scan(vertex_counts, vertex_offsets),
-                   self.programs.offsets_scan(index_counts, index_offsets)]
+        if count:
+            events.append(self.programs.offsets_scan_pair(vertex_counts, index_counts, vertex_offsets, index_offsets,
+                                                          np.uint64(count), size=2 * count))
         return vertex_offsets, index_offsets, events
 
     def _vertex_arrays(self, n: int) -> dict:
@@ -467,21 +466,32 @@ class Tessellator:
 
     def stage_vertices(self, controls, factors, vertex_offsets, patch_objects, vertex_range,
                        patch_range, forward_differencing=True, kind=BEZIER, patch_base=0, out=None,
-                       pattern=None):
+                       pattern=None, rows_per_patch: int | None = None):
         """Stage 4 for patches patch_range = (first, last) (scene numbers, all of one kind whose
         first patch is patch_base; controls: that kind's stage-4 input, Bézier patches or PN
         control points), whose vertices are vertex_range = (start, stop) -> dict of positions
         (V, 3), normals (V, 3), uv (V, 2), patch_ids (V,), object_ids (V,) device arrays,
-        V = stop - start (written into ``out`` when given), and the events."""
+        V = stop - start (written into ``out`` when given), and the events.  rows_per_patch:
+        work-items per patch of stages/vertex_rows.cl (0: one per patch, stages/vertices.cl;
+        None: as the Tessellator's ``rows_in_parallel``, with ``MAX_ROWS_PER_PATCH``)."""
         out = self._vertex_arrays(vertex_range[1] - vertex_range[0]) if out is None else out
         first, last = patch_range
         if vertex_range[1] == vertex_range[0] or last <= first:
             return out, []
         kind = kind_named(kind)
-        event = self.programs.kernel("vertices", kind=kind, pattern=pattern or kind.pattern)(
-            self.queue, _global_size(last - first), None, controls.data, factors.data, vertex_offsets.data,
-            patch_objects.data, np.uint32(first), np.uint32(last - first), np.uint32(patch_base),
-            np.uint64(vertex_range[0]), np.int32(forward_differencing), *(a.data for a in out.values()))
+        pattern = pattern or kind.pattern
+        arguments = (controls.data, factors.data, vertex_offsets.data, patch_objects.data, np.uint32(first),
+                     np.uint32(last - first), np.uint32(patch_base), np.uint64(vertex_range[0]),
+                     np.int32(forward_differencing))
+        if rows_per_patch is None and self.rows_in_parallel:
+            rows_per_patch = MAX_ROWS_PER_PATCH
+        if rows_per_patch:
+            event = self.programs.kernel("vertex_rows", kind=kind, pattern=pattern)(
+                self.queue, _global_size((last - first) * rows_per_patch), None, *arguments,
+                np.uint32(rows_per_patch), *(a.data for a in out.values()))
+        else:
+            event = self.programs.kernel("vertices", kind=kind, pattern=pattern)(
+                self.queue, _global_size(last - first), None, *arguments, *(a.data for a in out.values()))
         return out, [event]
 
     def stage_indices(self, factors, vertex_offsets, index_offsets, index_range, patch_range,
@@ -510,6 +520,104 @@ def combine_verified(parts: list[dict]) -> dict:
     worst = max(parts, key=lambda p: p["verify_ratio"])
     return dict(worst, verify_triangles=sum(p["verify_triangles"] for p in parts),
                 verify_ms=sum(p["verify_ms"] for p in parts))
+
+
+class _Raw:
+    """A buffer where the stage functions expect an array (they read ``.data`` only)."""
+
+    __slots__ = ("data",)
+
+    def __init__(self, data):
+        self.data = data
+
+
+class OutputArrays(dict):
+    """The pyopencl arrays of one output (name -> ``pyopencl.array.Array``, made on first
+    access: a frame whose output nobody looks at on the device does not pay for them)."""
+
+    def __init__(self, queue, layout, buffers: dict, num_vertices: int, num_triangles: int):
+        super().__init__()
+        self.queue, self.layout, self.buffers = queue, {name: (dtype, shape) for name, dtype, shape in layout}, buffers
+        self.num_vertices, self.num_triangles = num_vertices, num_triangles
+
+    def raw(self, name: str) -> _Raw:
+        return _Raw(self.buffers[name])
+
+    def __contains__(self, name) -> bool:
+        return name in self.layout
+
+    def __missing__(self, name):
+        if name not in self.layout:
+            raise KeyError(name)
+        dtype, shape = self.layout[name]
+        rows = self.num_triangles if name == "triangles" else self.num_vertices
+        self[name] = cl_array.Array(self.queue, (rows, *shape), dtype, data=self.buffers[name])
+        return self[name]
+
+    def keys(self):
+        return self.layout.keys()
+
+    def values(self):
+        return [self[name] for name in self.layout]
+
+    def items(self):
+        return [(name, self[name]) for name in self.layout]
+
+    def __iter__(self):
+        return iter(self.layout)
+
+    def __len__(self) -> int:
+        return len(self.layout)
+
+
+@dataclass
+class _Ready:
+    """An emit that ran synchronously, with PendingEmit's ``result``."""
+
+    tessellation: Tessellation
+
+    def result(self, on_device: bool = False) -> Tessellation:
+        return self.tessellation
+
+
+@dataclass
+class PendingEmit:
+    """Stages 4-5 enqueued (``Tessellator.emit_async``); ``result()`` waits and gives the
+    Tessellation."""
+
+    tessellator: "Tessellator"
+    plan: "Plan"
+    first: int
+    last: int
+    vertex_base: int
+    arrays: dict
+    events: dict
+    buffers: "OutputBuffers"
+    strips: np.ndarray | None = None  # host strips of a strip pattern (cltess.strips)
+
+    def result(self, on_device: bool = False) -> Tessellation:
+        plan, first, last, buffers, arrays = self.plan, self.first, self.last, self.buffers, self.arrays
+        all_events = [event for evs in self.events.values() for event in evs]
+        if all_events:
+            cl.wait_for_events(all_events)
+        stage_ms = {stage: _span_ms(evs) for stage, evs in self.events.items() if evs}
+        wall_ms = {"stages": (time.perf_counter() - plan.started) * 1e3}
+        stage_ms["total_wall"] = wall_ms["stages"]  # until the host arrays are there: Tessellation.fetch
+        stats = dict(plan.stats, first_patch=first, last_patch=last)
+        generation = buffers.generation
+
+        def read_back() -> dict:
+            host = buffers.read_back(arrays.num_vertices, arrays.num_triangles)
+            host["factors"], host["real_factors"] = plan.output_factors(first, last)
+            return host
+
+        device = DeviceOutput(arrays, self.tessellator.queue, self.vertex_base, read_back,
+                              valid=lambda: buffers.generation == generation)
+        tess = Tessellation.on_device(device, stage_ms, stats, wall_ms, self.strips)
+        if not on_device:
+            tess.fetch()
+            tess.device = None  # the device buffers go when the caller drops nothing but the host arrays
+        return tess
 
 
 class OutputBuffers:
@@ -553,8 +661,8 @@ class OutputBuffers:
         self.generation += 1
         self.unmap()
         flags = cl.mem_flags.READ_WRITE | (cl.mem_flags.ALLOC_HOST_PTR if self.mapped else 0)
-        arrays = {}
-        for name, dtype, shape in self._layout():
+        layout = self._layout()
+        for name, dtype, shape in layout:
             rows = num_triangles if name == "triangles" else num_vertices
             row_bytes = dtype.itemsize * int(np.prod(shape))
             buffer, capacity = self._buffers.get(name, (None, -1))
@@ -564,8 +672,8 @@ class OutputBuffers:
                 self._staging.pop(name, None)
                 buffer = cl.Buffer(self.context, flags, max(capacity, 1) * row_bytes)
                 self._buffers[name] = (buffer, capacity)
-            arrays[name] = cl_array.Array(self.queue, (rows, *shape), dtype, data=buffer)
-        return arrays
+        return OutputArrays(self.queue, layout, {name: self._buffers[name][0] for name, _, _ in layout},
+                            num_vertices, num_triangles)
 
     def read_back(self, num_vertices: int, num_triangles: int) -> dict:
         """The current generation's output as host arrays (see the class)."""

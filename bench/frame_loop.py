@@ -1,0 +1,383 @@
+"""Issue 15's benchmark: how close cltess gets to the memory limit, side by side in one run.
+
+    python bench/frame_loop.py [--device NAME] [--frames 10] [--scenes small] [--json out.json]
+
+On one OpenCL device, in this order, every figure a median (or the best, where said):
+
+1. **Bandwidth.** A plain fill kernel (``out[i] = value``, float4) over a large buffer: the
+   device's write bandwidth, best of 5 (profiling events).  Device -> host copies of the same
+   buffer into a page-locked host buffer (``ALLOC_HOST_PTR``, mapped once) and into a pageable
+   NumPy array: the read-back bandwidths, best of 3 (wall clock).
+2. **Uniform level 16.** 1,000 teapots (32,000 patches), every edge factor 16 (``max_factor``
+   16, a tolerance every patch misses): 580 MB of output.  Device time of the five stages
+   through a ``Session`` (output buffers reused), the same with stage 4 a work-item per
+   (patch, row) (``Tessellator(rows_in_parallel=True)``, stages/vertex_rows.cl), and through
+   one-shot ``Tessellator.tessellate`` (fresh buffers); output bytes / device time as a fraction of the fill bandwidth; the
+   session's read-back (``fetch``) rate against the page-locked bandwidth.
+3. **Frame loop on the paper's scenes** (``cltess bench``'s suite, 0.5 px): a ``Session``
+   follows ``--frames`` cameras on a circle around each scene's camera target.  Per frame:
+   the device time (sum of the stages' profiling spans), the host wall time until the stages
+   are done and the output is on the device ("device-resident"), and until the caller holds
+   host arrays ("host arrays": mapped on a CPU device, copied through page-locked memory on a
+   GPU).  The first frame (kernel builds, uploads) is left out.
+4. **Against a one-thread NumPy grid**, from 10k triangles up: P teapot patches at uniform
+   factor f; NumPy evaluates the same f x f grid per patch (float32, einsum over Bernstein
+   bases, positions, normals, uv, ids and triangles: the same output record) on one thread;
+   cltess runs it as a session frame with host arrays, and one-shot.
+
+The time before the first frame (scene generation, host adjacency, kernel builds) is not in
+any figure; it is printed per scene as "setup".
+"""
+from __future__ import annotations
+
+import os
+
+for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):  # the NumPy baseline: one thread
+    os.environ.setdefault(_name, "1")
+
+import argparse  # noqa: E402
+import json  # noqa: E402
+import math  # noqa: E402
+import statistics  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+import pyopencl as cl  # noqa: E402
+
+import cltess  # noqa: E402
+from cltess.backends.opencl import Tessellator  # noqa: E402
+from cltess.bench.suite import SUITE, device_info, machine_info, resolve_scenes  # noqa: E402
+from cltess.bench.scenes import PIXELS, mesh_camera  # noqa: E402
+from cltess.io import load_scene  # noqa: E402
+from cltess.scene import Camera, Scene  # noqa: E402
+from cltess.tessellation import BYTES_PER_INDEX, BYTES_PER_VERTEX  # noqa: E402
+
+SCENES = Path(__file__).resolve().parent.parent / "scenes"
+WALL_KEYS = ("total_wall",)
+
+FILL_SOURCE = """
+__kernel void fill(__global float4 *out, const float4 value, const ulong count) {
+    size_t i = get_global_id(0);
+    if (i < count) out[i] = value;
+}
+"""
+
+
+def device_ms(tess) -> float:
+    return sum(ms for stage, ms in tess.stage_ms.items() if stage not in WALL_KEYS)
+
+
+def output_bytes(tess) -> int:
+    return tess.num_vertices * BYTES_PER_VERTEX + tess.num_triangles * 3 * BYTES_PER_INDEX
+
+
+# --- 1. bandwidth ----------------------------------------------------------------------------
+
+def bandwidths(tessellator: Tessellator, size: int) -> dict:
+    """Fill-kernel write bandwidth (best of 5) and device -> host copy rates (best of 3)."""
+    context, queue = tessellator.context, tessellator.queue
+    fill = cl.Kernel(cl.Program(context, FILL_SOURCE).build(), "fill")
+    count = size // 16
+    buffer = cl.Buffer(context, cl.mem_flags.READ_WRITE, count * 16)
+    fills = []
+    for _ in range(6):
+        event = fill(queue, (-(-count // 256) * 256,), (256,), buffer, np.zeros(4, np.float32),
+                             np.uint64(count))
+        event.wait()
+        fills.append((event.profile.end - event.profile.start) * 1e-9)
+    pinned_buffer = cl.Buffer(context, cl.mem_flags.READ_WRITE | cl.mem_flags.ALLOC_HOST_PTR, count * 16)
+    pinned, _ = cl.enqueue_map_buffer(queue, pinned_buffer, cl.map_flags.READ | cl.map_flags.WRITE, 0, (count * 16,),
+                                      np.uint8, is_blocking=True)
+    pageable = np.empty(count * 16, np.uint8)
+    copies = {"pinned": [], "pageable": []}
+    for _ in range(4):
+        for name, target in (("pinned", pinned), ("pageable", pageable)):
+            started = time.perf_counter()
+            cl.enqueue_copy(queue, target, buffer, is_blocking=True)
+            copies[name].append(time.perf_counter() - started)
+    del pinned
+    return {"bytes": count * 16, "fill_bytes_per_s": count * 16 / min(fills[1:]),
+            "pinned_read_bytes_per_s": count * 16 / min(copies["pinned"][1:]),
+            "pageable_read_bytes_per_s": count * 16 / min(copies["pageable"][1:])}
+
+
+# --- scenes ----------------------------------------------------------------------------------
+
+def teapots(copies: int) -> Scene:
+    """``copies`` teapots (32 patches each) on a square grid, each turned about z."""
+    teapot = load_scene(SCENES / "teapot.bez")
+    side = math.ceil(math.sqrt(copies))
+    patches = []
+    for k in range(copies):
+        c, s = math.cos(0.7 * k), math.sin(0.7 * k)
+        matrix = np.array([[c, -s, 0, 8.0 * (k % side)], [s, c, 0, 8.0 * (k // side)], [0, 0, 1, 0], [0, 0, 0, 1]])
+        patches.append(np.asarray(teapot.patches, np.float64) @ matrix.T)
+    patches = np.concatenate(patches)
+    return Scene(patches, np.zeros(len(patches), np.int32), None, f"{copies} teapots")
+
+
+def uniform_request(factor: int) -> dict:
+    """Every edge factor ``factor``: the bound asks for more than that everywhere."""
+    return {"eps": 1e-7, "max_factor": factor}
+
+
+def suite_scene(key: str) -> Scene:
+    spec = SUITE[key]
+    built = spec.build()
+    if spec.kind == "pn":
+        mesh, view = built
+        return Scene.from_trimesh(mesh, camera=mesh_camera(mesh, **view), name=key)
+    return built
+
+
+def orbit(camera: Camera, count: int):
+    """``count`` cameras on the circle through ``camera``'s eye about its target (around z),
+    a full turn."""
+    target = np.asarray(camera.target, float)
+    offset = np.asarray(camera.eye, float) - target
+    for k in range(count):
+        angle = 2 * math.pi * k / count
+        c, s = math.cos(angle), math.sin(angle)
+        turned = np.array([c * offset[0] - s * offset[1], s * offset[0] + c * offset[1], offset[2]])
+        yield Camera(eye=target + turned, target=target, up=camera.up, fov_y_deg=camera.fov_y_deg,
+                     width=camera.width, height=camera.height, near=camera.near, far=camera.far)
+
+
+# --- the frame loop ----------------------------------------------------------------------------
+
+def frames(session, cameras, host: bool, **overrides) -> list[dict]:
+    """Per frame: device ms, wall ms until the output is on the device, and (host) until the
+    caller holds host arrays."""
+    out = []
+    for camera in cameras:
+        frame = session.tessellate(camera=camera, **overrides)
+        if host:
+            frame.fetch()
+        out.append({"device_ms": device_ms(frame), "stages_wall_ms": frame.wall_ms["stages"],
+                    "total_wall_ms": frame.wall_ms.get("total", frame.wall_ms["stages"]),
+                    "read_back_ms": frame.wall_ms.get("read_back", 0.0), "triangles": frame.num_triangles,
+                    "bytes": output_bytes(frame)})
+    return out
+
+
+def median(rows: list[dict], key: str) -> float:
+    return statistics.median(r[key] for r in rows)
+
+
+def frame_loop(tessellator, key: str, count: int) -> dict:
+    started = time.perf_counter()
+    scene = suite_scene(key)
+    session = cltess.Session(scene, tessellator=tessellator, pixels=PIXELS)
+    path = list(orbit(scene.camera, count))
+    session.tessellate(camera=path[0]).fetch()  # builds, uploads, host adjacency
+    setup = time.perf_counter() - started
+    resident = frames(session, path, host=False)
+    held = frames(session, path, host=True)
+    return {"scene": key, "setup_s": setup, "frames": count,
+            "triangles": median(resident, "triangles"), "device_ms": median(resident, "device_ms"),
+            "resident_wall_ms": median(resident, "stages_wall_ms"), "host_wall_ms": median(held, "total_wall_ms"),
+            "host_device_ms": median(held, "device_ms"), "read_back_ms": median(held, "read_back_ms")}
+
+
+# --- 2. uniform level 16 -----------------------------------------------------------------------
+
+def uniform(tessellator, scene, factor: int, repeat: int, band: dict) -> dict:
+    session = cltess.Session(scene, tessellator=tessellator, **uniform_request(factor))
+    first = session.tessellate().fetch()
+    runs = [session.tessellate() for _ in range(repeat)]
+    stage_ms = {stage: statistics.median(r.stage_ms[stage] for r in runs)
+                for stage in runs[0].stage_ms if stage not in WALL_KEYS}
+    device = statistics.median(device_ms(r) for r in runs)
+    size = output_bytes(first)
+    fetched = []
+    for _ in range(repeat):
+        frame = session.tessellate()
+        frame.fetch()
+        fetched.append(frame.wall_ms["read_back"])
+    one_shot = []
+    for _ in range(max(1, repeat // 2)):
+        tess = tessellator.tessellate(scene, **uniform_request(factor))
+        one_shot.append((device_ms(tess), tess.wall_ms["total"]))
+        del tess
+    read_back = statistics.median(fetched)
+    tessellator.rows_in_parallel = True  # stage 4 a work-item per (patch, row): stages/vertex_rows.cl
+    try:
+        rows_session = cltess.Session(scene, tessellator=tessellator, **uniform_request(factor))
+        rows_session.tessellate()
+        rows = [rows_session.tessellate() for _ in range(repeat)]
+        rows_ms = {stage: statistics.median(r.stage_ms[stage] for r in rows) for stage in ("vertices", "indices")}
+        rows_device = statistics.median(device_ms(r) for r in rows)
+        del rows, rows_session
+    finally:
+        tessellator.rows_in_parallel = False
+    return {"rows_device_ms": rows_device, "rows_vertices_ms": rows_ms["vertices"],
+            "patches": scene.num_patches, "factor": factor, "triangles": first.num_triangles, "bytes": size,
+            "stage_ms": stage_ms, "device_ms": device,
+            "vertices_indices_ms": stage_ms.get("vertices", 0) + stage_ms.get("indices", 0),
+            "fraction_of_fill": size / (device / 1e3) / band["fill_bytes_per_s"],
+            "stages45_fraction_of_fill": size / ((stage_ms.get("vertices", 0) + stage_ms.get("indices", 0)) / 1e3)
+            / band["fill_bytes_per_s"],
+            "read_back_ms": read_back, "read_back_bytes_per_s": size / (read_back / 1e3) if read_back else math.inf,
+            "one_shot_device_ms": statistics.median(d for d, _ in one_shot),
+            "one_shot_total_ms": statistics.median(t for _, t in one_shot)}
+
+
+# --- 4. the one-thread NumPy grid --------------------------------------------------------------
+
+def bernstein(t):
+    s = 1 - t
+    return np.stack([s ** 3, 3 * t * s ** 2, 3 * t ** 2 * s, t ** 3], axis=-1)
+
+
+def bernstein_derivative(t):
+    s = 1 - t
+    return np.stack([-3 * s ** 2, 3 * s ** 2 - 6 * t * s, 6 * t * s - 3 * t ** 2, 3 * t ** 2], axis=-1)
+
+
+def numpy_grid(patches: np.ndarray, factor: int) -> dict:
+    """The f x f grid of every patch in plain NumPy, float32, one thread: positions, unit
+    normals, uv, patch and object ids, and 2 f^2 triangles per patch."""
+    patches = np.asarray(patches, np.float32)  # (P, 4 v, 4 u, 4) homogeneous
+    t = np.linspace(0, 1, factor + 1, dtype=np.float32)
+    b, d = bernstein(t), bernstein_derivative(t)
+    rows = np.einsum("ui,pjic->pujc", b, patches)
+    rows_u = np.einsum("ui,pjic->pujc", d, patches)
+    h = np.einsum("vj,pujc->pvuc", b, rows)
+    h_u = np.einsum("vj,pujc->pvuc", b, rows_u)
+    h_v = np.einsum("vj,pujc->pvuc", d, rows)
+    w = h[..., 3:]
+    positions = h[..., :3] / w
+    s_u = (h_u[..., :3] - positions * h_u[..., 3:]) / w
+    s_v = (h_v[..., :3] - positions * h_v[..., 3:]) / w
+    normals = np.cross(s_u, s_v)
+    normals /= np.maximum(np.linalg.norm(normals, axis=-1, keepdims=True), np.float32(1e-30))
+    count, side = len(patches), factor + 1
+    u, v = np.meshgrid(t, t)
+    uv = np.broadcast_to(np.stack([u, v], -1), (count, side, side, 2)).reshape(-1, 2).copy()
+    patch_ids = np.repeat(np.arange(count, dtype=np.int32), side * side)
+    object_ids = np.zeros(count * side * side, np.int32)
+    j, i = np.meshgrid(np.arange(factor), np.arange(factor), indexing="ij")
+    corner = (j * side + i).ravel()
+    cell = np.stack([corner, corner + 1, corner + side + 1, corner + side], -1)
+    template = np.concatenate([cell[:, [0, 1, 2]], cell[:, [0, 2, 3]]]).astype(np.uint32)
+    triangles = (template[None] + (np.arange(count, dtype=np.uint32) * side * side)[:, None, None]).reshape(-1, 3)
+    return {"positions": positions.reshape(-1, 3), "normals": normals.reshape(-1, 3), "uv": uv,
+            "patch_ids": patch_ids, "object_ids": object_ids, "triangles": triangles}
+
+
+def grid_sizes(tessellator, sizes: list[tuple[int, int]], repeat: int) -> list[dict]:
+    out = []
+    teapot = teapots(1)
+    for copies, factor in sizes:
+        scene = teapots(copies) if copies > 1 else teapot
+        session = cltess.Session(scene, tessellator=tessellator, **uniform_request(factor))
+        session.tessellate().fetch()
+        frames_ = []
+        for _ in range(repeat):
+            frame = session.tessellate()
+            frame.fetch()
+            frames_.append((frame.wall_ms["total"], device_ms(frame), frame.num_triangles))
+        shots = []
+        for _ in range(max(1, repeat // 2)):
+            tess = tessellator.tessellate(scene, **uniform_request(factor))
+            shots.append(tess.wall_ms["total"])
+            del tess
+        grid = []
+        for _ in range(max(1, repeat // 2)):
+            started = time.perf_counter()
+            result = numpy_grid(scene.patches, factor)
+            grid.append((time.perf_counter() - started) * 1e3)
+            triangles_numpy = len(result["triangles"])
+            del result
+        out.append({"patches": scene.num_patches, "factor": factor, "triangles": frames_[0][2],
+                    "numpy_triangles": triangles_numpy,
+                    "session_host_ms": statistics.median(f[0] for f in frames_),
+                    "session_device_ms": statistics.median(f[1] for f in frames_),
+                    "one_shot_ms": statistics.median(shots), "numpy_ms": statistics.median(grid)})
+    return out
+
+
+# --- the report --------------------------------------------------------------------------------
+
+def report(record: dict) -> str:
+    band, level = record["bandwidth"], record["uniform"]
+    gb = lambda x: f"{x / 1e9:.1f}"  # noqa: E731
+    lines = [f"Device: {record['device']['name']} ({record['device']['platform']}); host "
+             f"{record['machine']['cpu']}, {record['machine']['cpus']} CPUs; load average before "
+             f"{record['load_before']}, after {record['load_after']}.", "",
+             "| fill kernel write GB/s | device -> pinned host GB/s | device -> pageable host GB/s | buffer MiB |",
+             "|---|---|---|---|",
+             f"| {gb(band['fill_bytes_per_s'])} | {gb(band['pinned_read_bytes_per_s'])} | "
+             f"{gb(band['pageable_read_bytes_per_s'])} | {band['bytes'] >> 20} |", "",
+             f"Uniform factor {level['factor']}, {level['patches']:,} patches, {level['triangles']:,} triangles, "
+             f"{level['bytes'] / 1e6:.0f} MB of output:", "",
+             "| | ms | GB/s of output | % of fill bandwidth |", "|---|---|---|---|"]
+    size = level["bytes"]
+    for label, ms in (("device, stages 1-5 (session)", level["device_ms"]),
+                      ("device, stages 4-5 (session)", level["vertices_indices_ms"]),
+                      ("device, stage 4 alone (session)", level["stage_ms"].get("vertices", 0.0)),
+                      ("device, stages 1-5, stage 4 a work-item per row (session)", level["rows_device_ms"]),
+                      ("device, stage 4 alone, a work-item per row (session)", level["rows_vertices_ms"]),
+                      ("device, stages 1-5 (one-shot, fresh buffers)", level["one_shot_device_ms"]),
+                      ("one-shot end to end, host arrays", level["one_shot_total_ms"]),
+                      ("session read-back (fetch)", level["read_back_ms"])):
+        rate = size / (ms / 1e3) if ms else math.inf
+        lines.append(f"| {label} | {ms:.2f} | {gb(rate)} | {100 * rate / band['fill_bytes_per_s']:.0f}% |")
+    lines += ["", f"Read-back: {gb(level['read_back_bytes_per_s'])} GB/s = "
+              f"{100 * level['read_back_bytes_per_s'] / band['pinned_read_bytes_per_s']:.0f}% of the pinned copy rate "
+              f"(on a CPU device the read-back is a mapping: no copy).", ""]
+    lines += [f"Frame loop, {record['frames']} cameras per scene, {PIXELS} px (median per frame, ms):", "",
+              "| scene | triangles | device | wall, output on device | ratio | wall, host arrays | ratio | "
+              "of which read-back | setup s |", "|---|---|---|---|---|---|---|---|---|"]
+    for f in record["frame_loop"]:
+        lines.append(f"| {f['scene']} | {f['triangles']:,.0f} | {f['device_ms']:.2f} | {f['resident_wall_ms']:.2f} | "
+                     f"{f['resident_wall_ms'] / f['device_ms']:.2f}x | {f['host_wall_ms']:.2f} | "
+                     f"{f['host_wall_ms'] / f['host_device_ms']:.2f}x | {f['read_back_ms']:.2f} | {f['setup_s']:.1f} |")
+    lines += ["", "Against a one-thread NumPy grid (uniform factor f, ms; cltess: host arrays held):", "",
+              "| patches | f | triangles | NumPy grid | cltess session frame | (its device time) | cltess one-shot | "
+              "NumPy / session |", "|---|---|---|---|---|---|---|---|"]
+    for g in record["grid"]:
+        lines.append(f"| {g['patches']:,} | {g['factor']} | {g['triangles']:,} | {g['numpy_ms']:.2f} | "
+                     f"{g['session_host_ms']:.2f} | {g['session_device_ms']:.2f} | {g['one_shot_ms']:.2f} | "
+                     f"{g['numpy_ms'] / g['session_host_ms']:.1f}x |")
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--device", help="OpenCL device (substring; default as cltess picks)")
+    parser.add_argument("--frames", type=int, default=10, help="cameras per scene in the frame loop")
+    parser.add_argument("--repeat", type=int, default=5, help="runs per figure of the uniform and grid tables")
+    parser.add_argument("--scenes", nargs="*", default=["all"], help="suite scenes or groups (all, bezier, pn, small)")
+    parser.add_argument("--copies", type=int, default=1000, help="teapots of the uniform level-16 scene")
+    parser.add_argument("--bandwidth-mib", type=int, default=512, help="buffer of the fill and copy measurements")
+    parser.add_argument("--json", help="write the record here too")
+    args = parser.parse_args(argv)
+    tessellator = Tessellator(args.device)
+    say = lambda text: print(text, file=sys.stderr, flush=True)  # noqa: E731
+    record = {"device": device_info(tessellator.device), "machine": machine_info(), "frames": args.frames,
+              "command": " ".join(sys.argv), "date": time.strftime("%Y-%m-%d %H:%M:%S %z"),
+              "load_before": [round(x, 1) for x in os.getloadavg()]}
+    say("bandwidth")
+    size = min(args.bandwidth_mib << 20, tessellator.device.max_mem_alloc_size // 2)
+    record["bandwidth"] = bandwidths(tessellator, size)
+    say("uniform level 16")
+    record["uniform"] = uniform(tessellator, teapots(args.copies), 16, args.repeat, record["bandwidth"])
+    record["frame_loop"] = []
+    for key in resolve_scenes(args.scenes):
+        say(f"frame loop: {key}")
+        record["frame_loop"].append(frame_loop(tessellator, key, args.frames))
+    say("NumPy grid")
+    sizes = [(1, 13), (10, 13), (100, 13), (1000, 13)]  # about 10k, 100k, 1M, 10M triangles
+    record["grid"] = grid_sizes(tessellator, sizes, args.repeat)
+    record["load_after"] = [round(x, 1) for x in os.getloadavg()]
+    print(report(record))
+    if args.json:
+        Path(args.json).write_text(json.dumps(record, indent=1, default=float) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,54 @@
+"""A binary cache of parsed patch files (issue 15): a large ``.bpt`` / ``.bez`` file read
+again is loaded as the ``.npy`` of its patches, keyed by a hash of its bytes (so an edited file
+is a new key, never a stale hit).
+
+Where: ``$CLTESS_SCENE_CACHE`` (a folder; ``0`` or ``off``: no cache), else
+``$XDG_CACHE_HOME/cltess/scenes`` or ``~/.cache/cltess/scenes``.  Only files of at least
+``MIN_BYTES`` are cached, only after they parsed without error, and a cache that cannot be read
+or written is passed over silently (the file is parsed as without it).
+"""
+from __future__ import annotations
+
+import hashlib
+import os
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from .writing import atomic_write
+
+#: Smaller files parse in milliseconds: not worth a cache entry.
+MIN_BYTES = 1 << 20
+#: Part of every key: a parser change that changes results must change it.
+VERSION = "1"
+
+
+def cache_folder() -> Path | None:
+    setting = os.environ.get("CLTESS_SCENE_CACHE")
+    if setting is not None:
+        return None if setting.strip().lower() in ("", "0", "off", "no", "false") else Path(setting)
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "cltess" / "scenes"
+
+
+def cached_patches(data: bytes, kind: str, parse: Callable[[bytes], np.ndarray]) -> np.ndarray:
+    """``parse(data)``, or the patches a previous parse of the same bytes stored."""
+    folder = cache_folder() if len(data) >= MIN_BYTES else None
+    if folder is None:
+        return parse(data)
+    entry = folder / f"{hashlib.blake2b(data, digest_size=20).hexdigest()}-{kind}-v{VERSION}.npy"
+    try:
+        patches = np.load(entry, allow_pickle=False)
+        if patches.dtype == np.float64 and patches.ndim == 4 and patches.shape[1:] == (4, 4, 4):
+            return patches
+    except (OSError, ValueError, EOFError):
+        pass
+    patches = parse(data)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with atomic_write(entry, "wb") as handle:
+            np.save(handle, np.ascontiguousarray(patches, np.float64), allow_pickle=False)
+    except OSError:
+        pass
+    return patches
