@@ -309,6 +309,17 @@ BY_LEVEL = {"semi_uniform_by_level": "semi_uniform",
 #: work-items per patch so that the last one does the remaining rows too.
 ROWS_IN_PARALLEL = {"many_patches_by_rows": "many_patches", "pn_icosphere_by_rows": "pn_icosphere",
                     "semi_uniform_by_rows": "semi_uniform", "collapsed_bottom_direct_by_rows": "collapsed_bottom_direct"}
+#: Scenarios of silhouette refinement (cltess/backends/opencl/silhouette.py): a scene and the
+#: refiner's options, one frame from the eye (x, y, z); every per-frame kernel
+#: (silhouette_alpha, silhouette_levels, crack_free, counts, silhouette_vertices, indices).
+SILHOUETTE = {
+    # PN with a sharp edge and an open boundary (alpha = 1 there), creases, phi, blended
+    "silhouette_pn_crease": (pn_icosphere, dict(max_level=2, phi=25.0, sharp_edges="crease"), (2.0, 0.3, 0.5)),
+    # Bezier patches (corner-quad normals), the error bound combined, the snap and blending off
+    "silhouette_bezier_no_snap": (semi_uniform, dict(max_level=2, eps=0.05, snap=False, blend=False), (0.5, 0.5, 3.0)),
+    # PN and Bezier in one scene (two parts, two vertex programs), blended, silhouettes alone
+    "silhouette_mixed": (pn_semi_uniform_mixed_culled, dict(max_level=2), (0.3, -2.0, 1.0)),
+}
 
 
 # --------------------------------------------------------------------------- self-tests
@@ -382,6 +393,13 @@ def run_scenario(name: str, tessellator, out_dir: Path) -> dict:
                                for k in ("positions", "normals", "uv", "patch_ids", "object_ids",
                                          "triangles", "factors")},
                             stats=dict(parts[0].stats, batches=len(parts)))
+    elif name in SILHOUETTE:
+        from cltess.backends.opencl.silhouette import SilhouetteRefiner
+
+        build, options, eye = SILHOUETTE[name]
+        scene, scenario_options = build()
+        options = {"sharp_edges": scenario_options.get("sharp_edges", "straight"), **options}
+        tess = SilhouetteRefiner(tessellator, scene, **options).frame(np.array(eye)).tessellation
     elif name in BY_LEVEL:
         from cltess.backends.opencl.levels import emit_by_level, plan_by_level
         from cltess.request import Request

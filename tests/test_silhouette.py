@@ -137,6 +137,14 @@ def test_bezier_scenes_use_the_control_net_corner_quads(tessellator, rng):
     assert welded.stats["welded_boundary_edges"] == 0 and welded.stats["welded_t_junctions"] == 0
 
 
+def test_the_rules_are_the_kernels():
+    import re
+    from cltess.backends.opencl.programs import kernel_dir
+    text = (kernel_dir() / "criteria" / "silhouette.h").read_text()
+    found = {name: int(value) for name, value in re.findall(r"^#define SILHOUETTE_RULE_(\w+) (\d+)", text, re.MULTILINE)}
+    assert found == {"PAIR": RULE_PAIR, "ALWAYS": RULE_ALWAYS, "NEVER": RULE_NEVER}
+
+
 # --- levels ----------------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("use_eps", [False, True])
@@ -386,3 +394,26 @@ def test_silhouette_frames_with_creases_stay_closed(tessellator, cylinder, rng):
     for eye in random_eyes(rng, 3, (2.0, 4.0)):
         welded = refiner.frame(eye).tessellation.welded()
         assert welded.stats["welded_boundary_edges"] == 0 and welded.stats["welded_t_junctions"] == 0
+
+
+@pytest.mark.parametrize("standard", ["CL1.2", "CL3.0"])
+def test_the_silhouette_programs_build_under_both_standards(standard):
+    """As tests/test_kernel_portability.py does for the five stages, on every usable CPU device."""
+    import pyopencl as cl
+    from cltess.backends.opencl.programs import composition, program_text
+    from cltess.device import list_devices, probe_device
+    from cltess.kinds import KINDS
+    from cltess.patterns import pattern_named
+
+    devices = [info for info in list_devices() if info.type == "CPU" and probe_device(info).usable]
+    assert devices
+    for info in devices:
+        context = cl.Context([info.device])
+        for kind in KINDS:
+            pattern = pattern_named("semi_uniform", kind.domain)
+            for stage in ("silhouette_alpha", "silhouette_levels", "silhouette_vertices"):
+                source, options = program_text(stage, *composition(stage, kind=kind, pattern=pattern))
+                try:
+                    cl.Program(context, source).build(options=options + [f"-cl-std={standard}"])
+                except cl.RuntimeError as error:
+                    pytest.fail(f"{stage} ({kind.name}) fails as {standard} on {info.name}:\n{error}")

@@ -88,8 +88,16 @@ class SilhouetteRefiner:
         self.request = Request(ObjectSpace(tolerance), forward_differencing=False, sharp_edges=sharp_edges,
                                pattern="semi_uniform", max_level=self.max_level)
         queue = tessellator.queue
-        self.plan = tessellator.plan(scene, self.request)
         kinds = [kind for kind in KINDS if kind.count(scene)]
+        # Every program is built before the first buffer exists (as Tessellator.plan does: a build
+        # in between made Oclgrind's uninitialised-value plugin report the scans' output).
+        programs = tessellator.programs
+        self._alpha_kernel = programs.kernel("silhouette_alpha")
+        self._levels_kernel = programs.kernel("silhouette_levels")
+        self._crack_free_kernel = programs.kernel("crack_free")
+        for kind in kinds:
+            programs.kernel("silhouette_vertices", kind=kind, pattern=self.request.pattern_for(kind))
+        self.plan = tessellator.plan(scene, self.request)
         hosts = [scene.prepared((kind.name, sharp_edges), lambda kind=kind: kind.prepare(scene, sharp_edges))
                  for kind in kinds]
         count = self.plan.num_patches
@@ -114,12 +122,6 @@ class SilhouetteRefiner:
         self._records = cl_array.empty(queue, (count, FACTOR_SLOTS), np.int32)
         self._scratch_factors = cl_array.empty(queue, (count, FACTOR_SLOTS), np.int32)
         self._scratch_flags = cl_array.empty(queue, count, np.int32)
-        programs = tessellator.programs
-        self._alpha_kernel = programs.kernel("silhouette_alpha")
-        self._levels_kernel = programs.kernel("silhouette_levels")
-        self._crack_free_kernel = programs.kernel("crack_free")
-        for part in self.plan.parts:
-            programs.kernel("silhouette_vertices", kind=part.kind, pattern=part.pattern)
         queue.finish()
         self.prepare_ms = (time.perf_counter() - started) * 1e3
 
@@ -139,10 +141,9 @@ class SilhouetteRefiner:
         groups = self.edges.num_groups
         if not groups:
             return []
-        eye4 = np.array([*eye, 0.0], np.float32)
         return [self._alpha_kernel(self.tessellator.queue, _global_size(groups), None, self._mids.data,
-                                   self._normals.data, self._rules.data, np.uint32(groups), eye4,
-                                   self._alpha.data)]
+                                   self._normals.data, self._rules.data, np.uint32(groups),
+                                   *(np.float32(x) for x in eye), self._alpha.data)]
 
     def frame(self, camera, blend: bool | None = None, snap: bool | None = None,
               alpha: np.ndarray | None = None) -> SilhouetteFrame:
