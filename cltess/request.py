@@ -87,7 +87,7 @@ class Request:
             raise ValueError(f"level_function needs pattern 'sd2', got pattern {self.pattern!r}")
         low_high = tuple(self.level_factors) if isinstance(self.level_factors, (tuple, list)) else ()
         if len(low_high) != 2 or not all(isinstance(x, numbers.Real) and math.isfinite(x) for x in low_high) \
-                or not 1 <= low_high[0] <= low_high[1] <= self.max_factor:
+                or not 1 <= low_high[0] <= low_high[1] <= (self.max_factor if self.level_function else math.inf):
             raise ValueError(f"level_factors must be (low, high) with 1 <= low <= high <= max_factor "
                              f"({self.max_factor}), got {self.level_factors!r}")
         if self.depth_map not in DEPTH_MAPS:

@@ -269,6 +269,33 @@ def pn_semi_uniform_mixed_culled():
     return scene, dict(options, pattern="semi_uniform", max_level=3)
 
 
+def pn_sd2_bound():
+    """SD-2 (issue 13), the bound-keeping level function: per-vertex atomic max of stage 1's
+    factors, fixed-point factors, fans and grids, strip output; open boundary and sharp edge."""
+    from cltess.scene import Scene
+
+    return Scene.from_meshes([icosphere_mesh()], name="icosphere"), dict(eps=0.02, max_factor=8, pattern="sd2")
+
+
+def pn_sd2_depth_silhouette():
+    """SD-2 from the eye-plane distance (quadratic map, this frame's depth range: pyopencl's
+    reductions) beside a mesh refined at its silhouette, direct evaluation."""
+    from cltess.scene import Scene
+
+    camera = _camera([2.5, -1.0, 0.8], [0.0, 0.0, 0.0])
+    scene = Scene.from_meshes([icosphere_mesh()], camera=camera, name="icosphere")
+    return scene, dict(eps=0.02, pattern="sd2", level_function="depth", depth_map="quadratic",
+                       level_factors=(1.5, 6.5), forward_differencing=False)
+
+
+def pn_sd2_silhouette():
+    from cltess.scene import Scene
+
+    camera = _camera([0.3, -3.0, 1.0], [0.0, 0.0, 0.0])
+    scene = Scene.from_meshes([icosphere_mesh()], camera=camera, name="icosphere")
+    return scene, dict(eps=0.02, level_function="silhouette", level_factors=(1.0, 5.0))
+
+
 SCENARIOS = {
     "uniform": uniform,
     "one_transition": one_transition,
@@ -291,6 +318,9 @@ SCENARIOS = {
     "semi_uniform": semi_uniform,
     "semi_uniform_capped_direct": semi_uniform_capped_direct,
     "pn_semi_uniform_mixed_culled": pn_semi_uniform_mixed_culled,
+    "pn_sd2_bound": pn_sd2_bound,
+    "pn_sd2_depth": pn_sd2_depth_silhouette,
+    "pn_sd2_silhouette": pn_sd2_silhouette,
 }
 
 #: Scenarios whose tessellation is then measured on the device (Tessellator.verify,

@@ -30,6 +30,7 @@
 #undef pattern_primitives
 #undef CLTESS_PATTERNS_LAYOUT_H  /* layout.h again below, for this pattern's own names */
 #undef PATTERN_EDGE_POINTS
+#undef PATTERN_UNIFORM_ROWS
 
 #define SD2_CULLED 0
 #define SD2_FAN 1        /* two equal factors: the SD-2 pattern */
