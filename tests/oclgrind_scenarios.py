@@ -269,6 +269,20 @@ def pn_semi_uniform_mixed_culled():
     return scene, dict(options, pattern="semi_uniform", max_level=3)
 
 
+def esc():
+    """ESC (issue 14): a 2x2 grid of flat and curved patches, so stage 1's masks differ per coarse
+    edge, the OR crack pass (crack/or_masks.h) and the mask pattern (patterns/esc.h)."""
+    scene, _ = two_transitions_adjacent()
+    return scene, dict(eps=0.02, pattern="esc")
+
+
+def esc_collapsed_lid_screen():
+    """ESC on the teapot lid (collapsed edges) in screen space: per-patch tolerances, levels 2."""
+    scene = teapot([20, 21, 22, 23])
+    scene.camera = _camera(np.array([0.0, -6.0, 5.0]), np.array([0.0, 0.0, 3.0]))
+    return scene, dict(pixels=1.0, pattern="esc", max_level=2)
+
+
 SCENARIOS = {
     "uniform": uniform,
     "one_transition": one_transition,
@@ -291,6 +305,8 @@ SCENARIOS = {
     "semi_uniform": semi_uniform,
     "semi_uniform_capped_direct": semi_uniform_capped_direct,
     "pn_semi_uniform_mixed_culled": pn_semi_uniform_mixed_culled,
+    "esc": esc,
+    "esc_collapsed_lid_screen": esc_collapsed_lid_screen,
 }
 
 #: Scenarios whose tessellation is then measured on the device (Tessellator.verify,
