@@ -23,6 +23,10 @@ copy at the scene's eps for Teacups (every copy is the same mesh up to translati
 triangle of the big scene (at most --error-triangles; a sampled maximum, so a lower bound).
 "dev/eps" is that deviation over the eps the row was made with.
 
+Evaluators (step 1 of issue 14): direct Bernstein, NBM-Horner and forward differencing on a
+13 x 13 grid of every Teacups patch (kernels/esc/evaluate_grid.cl): kernel time (profiling, best
+of --repeat) and the max error against float64 relative to the teacup's size.
+
 Times: device milliseconds of stages 1-5 (OpenCL profiling events, their spans summed; the
 read-backs to the host not included), median of --repeat runs after one warm-up, on the device
 named (--device; default cltess's default device).  Forward differencing is on for the transition
@@ -112,6 +116,28 @@ def zs_request(eps):
     return Request.of(eps=eps)
 
 
+def evaluators(tessellator, patches, n: int, repeat: int) -> list[dict]:
+    """Device ms of the three evaluators on an n x n grid per patch (cltess/esc/evaluate.py), and
+    their max error against float64 relative to the patches' size (one teacup's patches)."""
+    from cltess.esc.evaluate import evaluate_grid
+    from cltess.surfaces.bezier import evaluate
+
+    t = np.linspace(0, 1, n + 1)
+    u, v = np.meshgrid(t, t)
+    exact = np.stack([evaluate(p, u.ravel(), v.ravel())[0] for p in patches[:26]]).reshape(-1, n + 1, n + 1, 3)
+    scale = np.abs(exact).max()
+    rows = []
+    for method in ("direct", "nbm", "fd"):
+        evaluate_grid(tessellator.queue, patches, n, method)  # build, warm up
+        positions, _, seconds = evaluate_grid(tessellator.queue, patches, n, method, repeat=repeat)
+        error = float(np.abs(positions[:26] - exact).max() / scale)
+        rows.append({"method": method, "patches": len(patches), "points": len(patches) * (n + 1) ** 2,
+                     "device_ms": seconds * 1e3, "relative_error": error})
+        print(f"  {method:<7} {rows[-1]['points']:>10,} points  {seconds * 1e3:8.2f} ms  max error / size {error:.2e}",
+              flush=True)
+    return rows
+
+
 def table(tessellator, scene, error_scene, repeat: int, sample_triangles, diagonal: float) -> list[dict]:
     """The Table 1 rows of one scene.  error_scene: the scene whose mesh the errors are measured
     on (one teacup for Teacups, the scene itself otherwise)."""
@@ -188,6 +214,7 @@ def main(argv=None) -> int:
     parser.add_argument("--big", type=int, default=8110, help="patches of the bigguy scene (0: skip it)")
     parser.add_argument("--error-triangles", type=int, default=100_000,
                         help="the big scene's error: every k-th triangle, at most this many")
+    parser.add_argument("--evaluators-only", action="store_true", help="only the evaluator timings")
     parser.add_argument("--json", type=Path)
     parser.add_argument("--csv", type=Path, help="the triangles-against-error points")
     parser.add_argument("--plot", type=Path, help="PNG of triangles against error (needs matplotlib)")
@@ -199,6 +226,10 @@ def main(argv=None) -> int:
     print(f"device: {tessellator.device.name.strip()}")
     started = time.perf_counter()
     cups, cup = teacups()
+    print("evaluators, 13 x 13 points per patch, Teacups' 2,600 patches (best of --repeat, kernel only):")
+    timings = evaluators(tessellator, cups.patches, 12, args.repeat)
+    if args.evaluators_only:
+        return 0
     rows = []
     print(cups.name, cups.num_patches, "patches")
     rows += table(tessellator, cups, cup, args.repeat, None, cup.diagonal)
@@ -220,7 +251,8 @@ def main(argv=None) -> int:
     if args.plot:
         plot(points, args.plot, f"teacup (26 patches): triangles against measured error, {tessellator.device.name.strip()}")
     if args.json:
-        args.json.write_text(json.dumps({"device": tessellator.device.name.strip(), "rows": rows, "curve": points},
+        args.json.write_text(json.dumps({"device": tessellator.device.name.strip(), "evaluators": timings, "rows": rows,
+                                         "curve": points},
                                         indent=1))
     print(f"wall {time.perf_counter() - started:.0f} s")
     return 0
