@@ -4,7 +4,7 @@
     cltess tessellate SCENE (--eps E | --eps P% | --pixels PX) [--no-fd] [--max-factor N]
                       [--max-memory SIZE] [--sharp-edges {straight,average,keep}] [--crease-angle DEG]
                       [--no-orient] [--no-weld] [--uv {drop,seam}] [--max-output SIZE]
-                      [--preview PNG] [--pattern {transition,semi-uniform}] [--max-level L]
+                      [--preview PNG] [--pattern {transition,semi-uniform,sd2,esc}] [--max-level L]
                       [--emit {per-patch,by-level}]
                       [--check-t-junctions] [--device NAME] [--quiet] -o OUT
     cltess render SCENE (--eps E | --eps P% | --pixels PX) [--size W[xH]] [--color {shade,factor}]
@@ -137,7 +137,7 @@ def _crease_angle(text: str) -> float:
 
 
 #: --pattern's choices: the pattern families (cltess.patterns.FAMILIES), as the command line spells them.
-PATTERN_CHOICES = {"transition": "transition", "semi-uniform": "semi_uniform", "sd2": "sd2"}
+PATTERN_CHOICES = {"transition": "transition", "semi-uniform": "semi_uniform", "sd2": "sd2", "esc": "esc"}
 #: --emit's choices: cltess.request.EMIT_MODES, as the command line spells them.
 EMIT_CHOICES = {"per-patch": "per_patch", "by-level": "by_level"}
 
@@ -232,10 +232,13 @@ def build_parser() -> argparse.ArgumentParser:
     shared.add_argument("--pattern", choices=tuple(PATTERN_CHOICES), default="transition",
                         help="tessellation pattern of every patch: transition strips between edge factors "
                              "(default), or semi-uniform (Dyken et al. 2009: a uniform 2^m grid per patch, "
-                             "edges snapped to their own dyadic level; factors rounded up to powers of two)")
+                             "edges snapped to their own dyadic level; factors rounded up to powers of two), or esc "
+                             "(Bezier patches: Hu et al. 2014's distance test on the candidates of a level-L "
+                             "pattern, docs/esc.md)")
     shared.add_argument("--max-level", type=_max_level, default=6, metavar="L",
                         help="semi-uniform: the largest level (edge factor 2^L; default 6); a patch that "
-                             "needs more is saturated")
+                             "needs more is saturated.  esc: the candidate level L (L+1 steps per coarse edge, "
+                             "at most 3, the default)")
     shared.add_argument("--emit", choices=tuple(EMIT_CHOICES), default="per-patch",
                         help="semi-uniform: run stages 4-5 per patch (default), or by level: the patches in one "
                              "queue per level, each level evaluated from one shared template (Dyken et al. "

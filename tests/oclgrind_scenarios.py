@@ -296,6 +296,20 @@ def pn_sd2_silhouette():
     return scene, dict(eps=0.02, level_function="silhouette", level_factors=(1.0, 5.0))
 
 
+def esc():
+    """ESC (issue 14): a 2x2 grid of flat and curved patches, so stage 1's masks differ per coarse
+    edge, the OR crack pass (crack/or_masks.h) and the mask pattern (patterns/esc.h)."""
+    scene, _ = two_transitions_adjacent()
+    return scene, dict(eps=0.02, pattern="esc")
+
+
+def esc_collapsed_lid_screen():
+    """ESC on the teapot lid (collapsed edges) in screen space: per-patch tolerances, levels 2."""
+    scene = teapot([20, 21, 22, 23])
+    scene.camera = _camera(np.array([0.0, -6.0, 5.0]), np.array([0.0, 0.0, 3.0]))
+    return scene, dict(pixels=1.0, pattern="esc", max_level=2)
+
+
 SCENARIOS = {
     "uniform": uniform,
     "one_transition": one_transition,
@@ -321,6 +335,10 @@ SCENARIOS = {
     "pn_sd2_bound": pn_sd2_bound,
     "pn_sd2_depth": pn_sd2_depth_silhouette,
     "pn_sd2_silhouette": pn_sd2_silhouette,
+
+
+    "esc": esc,
+    "esc_collapsed_lid_screen": esc_collapsed_lid_screen,
 }
 
 #: Scenarios whose tessellation is then measured on the device (Tessellator.verify,

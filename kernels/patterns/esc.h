@@ -36,63 +36,75 @@ inline uint esc_reverse_bits(uint mask, int count)
 
 inline int esc_level(int4 f) { return (f.s0 >> ESC_LEVEL_SHIFT) & 3; }
 
-/* Coarse edge c of patch edge e's segment s (counter-clockwise), and whether counter-clockwise
- * runs against c's canonical direction (esc.py PATCH_EDGE_COARSE, PATCH_EDGE_AGAINST). */
-inline int esc_boundary_coarse(int e, int s)
+/* Where coarse edge c's mask lives in the record: its number among the interior edges (bits
+ * k L .. of the 64 interior bits), or -1 on the boundary; there patch edge e = ESC_EDGE_OF[c],
+ * segment s = ESC_SEGMENT_OF[c] counter-clockwise (esc.py INTERIOR_EDGES, PATCH_EDGE_COARSE). */
+__constant int ESC_INTERIOR_INDEX[33] = {-1, -1, -1, 0, 1, 2, 3, 4, 5, -1, -1, -1, -1, -1, -1, 6, 7, 8,
+                                         9, 10, 11, -1, -1, -1, 12, 13, 14, 15, 16, 17, 18, 19, 20};
+__constant int ESC_EDGE_OF[33] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 2, 2, 3, 3, 3, 0, 0, 0,
+                                  0, 0, 0, 1, 1, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+__constant int ESC_SEGMENT_OF[33] = {0, 1, 2, 0, 0, 0, 0, 0, 0, 2, 1, 0, 2, 1, 0, 0, 0, 0,
+                                     0, 0, 0, 0, 1, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+
+/* A record read once: its slots, the 64 interior bits, the level. */
+typedef struct {
+    int4 f;
+    ulong interior;
+    int level, n, m;
+} esc_record;
+
+inline esc_record esc_read(int4 f)
 {
-    return e == 0 ? ESC_H(s, 0) : e == 1 ? ESC_V(3, s) : e == 2 ? ESC_H(2 - s, 3) : ESC_V(0, 2 - s);
+    esc_record r;
+    r.f = f;
+    r.level = esc_level(f);
+    r.n = r.level + 1;
+    r.m = 3 * r.n;
+    r.interior = 0;
+    for (int e = 0; e < 4; ++e)
+        r.interior |= (ulong)(((uint)factor_of(f, e) >> ESC_INTERIOR_SHIFT) & ((1u << ESC_INTERIOR_BITS) - 1u))
+                      << (ESC_INTERIOR_BITS * e);
+    return r;
 }
 
-/* The 33 masks (canonical directions) of a record. */
-inline void esc_decode(int4 f, __private uint masks[33])
+/* The L-bit mask of coarse edge c, in its canonical direction. */
+inline uint esc_mask(__private const esc_record *r, int c)
 {
-    int level = esc_level(f);
+    int level = r->level;
     uint full = (1u << level) - 1u;
-    ulong interior = 0;
-    for (int e = 0; e < 4; ++e)
-        interior |= (ulong)(((uint)factor_of(f, e) >> ESC_INTERIOR_SHIFT) & ((1u << ESC_INTERIOR_BITS) - 1u))
-                    << (ESC_INTERIOR_BITS * e);
-    int k = 0;
-    for (int c = 0; c < 33; ++c) {
-        int boundary = (c < 3) || (c >= 9 && c < 12) || (c >= 12 && c < 15) || (c >= 21 && c < 24);
-        if (!boundary) {
-            masks[c] = (uint)(interior >> (k * level)) & full;
-            ++k;
-        }
-    }
-    for (int e = 0; e < 4; ++e) {
-        uint slot = (uint)factor_of(f, e);
-        uint bits = slot & ESC_BOUNDARY_BITS & ((1u << (3 * level)) - 1u);
-        uint ccw = (slot & ESC_REVERSED) ? esc_reverse_bits(bits, 3 * level) : bits;
-        for (int s = 0; s < 3; ++s) {
-            uint mask = (ccw >> (s * level)) & full;
-            masks[esc_boundary_coarse(e, s)] = e >= 2 ? esc_reverse_bits(mask, level) : mask;
-        }
-    }
+    int k = ESC_INTERIOR_INDEX[c];
+    if (k >= 0)
+        return (uint)(r->interior >> (k * level)) & full;
+    int e = ESC_EDGE_OF[c], s = ESC_SEGMENT_OF[c];
+    uint slot = (uint)factor_of(r->f, e);
+    int reversed = (slot & ESC_REVERSED) != 0;  /* stored in the curve's direction, not counter-clockwise */
+    uint mask = (slot >> ((reversed ? 2 - s : s) * level)) & full;
+    return reversed != (e >= 2) ? esc_reverse_bits(mask, level) : mask;  /* edges 2, 3 run against +u, +v */
 }
 
 /* Is lattice point (x, y) inserted?  Coarse corners always; a point on a coarse edge by its bit;
  * a point inside a coarse triangle when its row's left or right end is (rows parallel to the
  * diagonal base; esc.py coarse_triangle). */
-inline int esc_present(__private const uint masks[33], int n, int x, int y)
+inline int esc_present(__private const esc_record *r, int x, int y)
 {
+    int n = r->n;
     int i = min(x / n, 2), a = x - n * i, j = min(y / n, 2), b = y - n * j;
     if (a == n) { ++i; a = 0; }  /* the last lattice line belongs to coarse corner 3 */
     if (b == n) { ++j; b = 0; }
     if (a == 0 && b == 0)
         return 1;
     if (b == 0)
-        return (masks[ESC_H(i, j)] >> (a - 1)) & 1u;
+        return (esc_mask(r, ESC_H(i, j)) >> (a - 1)) & 1u;
     if (a == 0)
-        return (masks[ESC_V(i, j)] >> (b - 1)) & 1u;
+        return (esc_mask(r, ESC_V(i, j)) >> (b - 1)) & 1u;
     if (a == b)
-        return (masks[ESC_D(i, j)] >> (a - 1)) & 1u;
-    if (a > b) {  /* the lower triangle, apex (i+1, j): row r = n - (a - b) */
-        int r = n - (a - b);
-        return ((masks[ESC_V(i + 1, j)] >> (r - 1)) | (masks[ESC_H(i, j)] >> (n - r - 1))) & 1u;
+        return (esc_mask(r, ESC_D(i, j)) >> (a - 1)) & 1u;
+    if (a > b) {  /* the lower triangle, apex (i+1, j): row q = n - (a - b) */
+        int q = n - (a - b);
+        return ((esc_mask(r, ESC_V(i + 1, j)) >> (q - 1)) | (esc_mask(r, ESC_H(i, j)) >> (n - q - 1))) & 1u;
     }
-    int r = n - (b - a);  /* the upper triangle, apex (i, j+1) */
-    return ((masks[ESC_V(i, j)] >> (n - r - 1)) | (masks[ESC_H(i, j + 1)] >> (r - 1))) & 1u;
+    int q = n - (b - a);  /* the upper triangle, apex (i, j+1) */
+    return ((esc_mask(r, ESC_V(i, j)) >> (n - q - 1)) | (esc_mask(r, ESC_H(i, j + 1)) >> (q - 1))) & 1u;
 }
 
 /* Lattice point k of patch edge e, counter-clockwise from its first corner. */
@@ -101,45 +113,68 @@ inline int2 esc_edge_lattice(int e, int k, int m)
     return e == 0 ? (int2)(k, 0) : e == 1 ? (int2)(m, k) : e == 2 ? (int2)(m - k, m) : (int2)(0, m - k);
 }
 
-inline int esc_count_edge(__private const uint masks[33], int n, int e)
+/* Bit t: point t (0 .. m) of the lattice line along +u (y = index n) or +v (x = index n) is
+ * inserted: its coarse corners and its 3 coarse edges' candidates. */
+inline uint esc_line_bits(__private const esc_record *r, int vertical, int index)
 {
-    int count = 0;
-    for (int k = 0; k < 3 * n; ++k) {
-        int2 p = esc_edge_lattice(e, k, 3 * n);
-        count += esc_present(masks, n, p.x, p.y);
-    }
-    return count;
+    int n = r->n;
+    uint bits = 1u << r->m;
+    for (int s = 0; s < 3; ++s)
+        bits |= (1u << (s * n)) | (esc_mask(r, vertical ? ESC_V(index, s) : ESC_H(s, index)) << (s * n + 1));
+    return bits;
 }
 
-inline int esc_count_row(__private const uint masks[33], int n, int y)
+/* Bit k: point k of patch edge e (k = 0 .. m-1, counter-clockwise) is inserted. */
+inline uint esc_edge_bits(__private const esc_record *r, int e)
 {
-    int count = 0;
-    for (int x = 1; x < 3 * n; ++x)
-        count += esc_present(masks, n, x, y);
-    return count;
+    uint line = esc_line_bits(r, e & 1, e == 0 ? 0 : e == 1 ? 3 : e == 2 ? 3 : 0);
+    return (e >= 2 ? esc_reverse_bits(line, r->m + 1) : line) & ((1u << r->m) - 1u);
+}
+
+/* Bit x: interior point (x, y) is inserted (x = 1 .. m-1, y = 1 .. m-1): esc_present row-wise. */
+inline uint esc_row_bits(__private const esc_record *r, int y)
+{
+    int n = r->n, j = y / n, b = y - n * j;
+    uint bits = 0;
+    if (b == 0) {
+        bits = esc_line_bits(r, 0, j);
+    } else {
+        for (int i = 0; i < 3; ++i) {
+            uint v = esc_mask(r, ESC_V(i, j)), v1 = esc_mask(r, ESC_V(i + 1, j)), d = esc_mask(r, ESC_D(i, j));
+            uint h = esc_mask(r, ESC_H(i, j)), h1 = esc_mask(r, ESC_H(i, j + 1));
+            int x0 = i * n;
+            bits |= ((v >> (b - 1)) & 1u) << x0 | ((d >> (b - 1)) & 1u) << (x0 + b);
+            for (int a = 1; a < b; ++a)  /* the upper triangle */
+                bits |= (((v >> (b - a - 1)) | (h1 >> (n - b + a - 1))) & 1u) << (x0 + a);
+            for (int a = b + 1; a < n; ++a)  /* the lower triangle */
+                bits |= (((v1 >> (n - a + b - 1)) | (h >> (a - b - 1))) & 1u) << (x0 + a);
+        }
+    }
+    return bits & ((1u << r->m) - 2u);
+}
+
+/* The position of the k-th set bit of bits (k from 0); 32 if none. */
+inline int esc_nth_bit(uint bits, int k)
+{
+    for (int at = 0; at < 32; ++at)
+        if ((bits >> at) & 1u)
+            if (k-- == 0)
+                return at;
+    return 32;
 }
 
 /* --- the vertex layout (docs/extending.md; patterns/layout.h) -------------------------------- */
 
 inline int esc_ring_count(int4 f, int e)
 {
-    uint masks[33];
-    esc_decode(f, masks);
-    return esc_count_edge(masks, esc_level(f) + 1, e);
+    esc_record r = esc_read(f);
+    return popcount(esc_edge_bits(&r, e));
 }
 
 inline edge_param pattern_ring_param(int4 f, int e, int k)
 {
-    uint masks[33];
-    esc_decode(f, masks);
-    int n = esc_level(f) + 1, m = 3 * n, seen = -1, at = 0;
-    for (; at < m; ++at) {
-        int2 p = esc_edge_lattice(e, at, m);
-        seen += esc_present(masks, n, p.x, p.y);
-        if (seen == k)
-            break;
-    }
-    edge_param t = {at, m};
+    esc_record r = esc_read(f);
+    edge_param t = {esc_nth_bit(esc_edge_bits(&r, e), k), r.m};
     return t;
 }
 
@@ -151,25 +186,15 @@ inline int pattern_rows(int4 f) { return 3 * (esc_level(f) + 1) - 1; }
 
 inline int pattern_row(int4 f, int j)
 {
-    uint masks[33];
-    esc_decode(f, masks);
-    return esc_count_row(masks, esc_level(f) + 1, j) + 1;
+    esc_record r = esc_read(f);
+    return popcount(esc_row_bits(&r, j)) + 1;
 }
 
 inline float3 pattern_row_point(int4 f, int j, int i)
 {
-    int n = esc_level(f) + 1, m = 3 * n, x = 0;
-    if (i > 0) {
-        uint masks[33];
-        esc_decode(f, masks);
-        int seen = 0;
-        for (x = 1; x < m; ++x) {
-            seen += esc_present(masks, n, x, j);
-            if (seen == i)
-                break;
-        }
-    }
-    return (float3)((float)x / (float)m, (float)j / (float)m, 0.0f);
+    esc_record r = esc_read(f);
+    int x = i == 0 ? 0 : min(esc_nth_bit(esc_row_bits(&r, j), i - 1), r.m);
+    return (float3)((float)x / (float)r.m, (float)j / (float)r.m, 0.0f);
 }
 
 #include "patterns/layout.h"
@@ -177,9 +202,10 @@ inline float3 pattern_row_point(int4 f, int j, int i)
 /* --- the primitives ------------------------------------------------------------------------- */
 
 typedef struct {
-    uint masks[33];
-    int n, m, ring[5];   /* ring[e]: local number of edge e's first point; ring[4] = the ring */
-    int rows[13];        /* rows[y]: local number of row y's first interior point (y = 1 .. m-1) */
+    esc_record r;
+    uint edge_bits[4], row_bits[13];  /* esc_edge_bits, esc_row_bits (rows 1 .. m-1) */
+    int ring[5];         /* ring[e]: local number of edge e's first point; ring[4] = the ring */
+    int rows[13];        /* rows[y]: local number of row y's first interior point */
     int collapsed;
 } esc_patch;
 
@@ -187,7 +213,7 @@ typedef struct {
  * corner (esc.py patch_mesh remap, in its order). */
 inline uint esc_index(__private const esc_patch *g, int2 p)
 {
-    int m = g->m;
+    int m = g->r.m;
     for (int e = 0; e < 4; ++e) {  /* a collapsed edge's points, both corners included */
         int on = e == 0 ? p.y == 0 : e == 1 ? p.x == m : e == 2 ? p.y == m : p.x == 0;
         if (on && ((g->collapsed >> e) & 1))
@@ -196,19 +222,10 @@ inline uint esc_index(__private const esc_patch *g, int2 p)
     for (int e = 0; e < 4; ++e) {
         int k = e == 0 ? (p.y == 0 ? p.x : -1) : e == 1 ? (p.x == m ? p.y : -1)
               : e == 2 ? (p.y == m ? m - p.x : -1) : (p.x == 0 ? m - p.y : -1);
-        if (k < 0 || k >= m)
-            continue;  /* not on edge e, or its last corner (edge e+1's first) */
-        int rank = 0;
-        for (int q = 0; q < k; ++q) {
-            int2 r = esc_edge_lattice(e, q, m);
-            rank += esc_present(g->masks, g->n, r.x, r.y);
-        }
-        return (uint)(g->ring[e] + rank);
+        if (k >= 0 && k < m)  /* on edge e, not its last corner (edge e+1's first) */
+            return (uint)(g->ring[e] + popcount(g->edge_bits[e] & ((1u << k) - 1u)));
     }
-    int rank = 0;
-    for (int x = 1; x < p.x; ++x)
-        rank += esc_present(g->masks, g->n, x, p.y);
-    return (uint)(g->rows[p.y] + rank);
+    return (uint)(g->rows[p.y] + popcount(g->row_bits[p.y] & ((1u << p.x) - 1u)));
 }
 
 /* Coarse triangle t (0..17: cell (i, j) = (t/2 % 3, t/6), lower then upper): apex, B0, B1 in
@@ -216,21 +233,22 @@ inline uint esc_index(__private const esc_patch *g, int2 p)
  * order (esc.py COARSE_TRIANGLES). */
 inline void esc_coarse(__private const esc_patch *g, int t, __private int2 corner[3], __private uint bits[3])
 {
-    int cell = t / 2, i = cell % 3, j = cell / 3, level = g->n - 1;
+    int cell = t / 2, i = cell % 3, j = cell / 3, level = g->r.level;
+    __private const esc_record *r = &g->r;
     if ((t & 1) == 0) {
         corner[0] = (int2)(i + 1, j);
         corner[1] = (int2)(i + 1, j + 1);
         corner[2] = (int2)(i, j);
-        bits[0] = g->masks[ESC_V(i + 1, j)];
-        bits[1] = esc_reverse_bits(g->masks[ESC_H(i, j)], level);
-        bits[2] = esc_reverse_bits(g->masks[ESC_D(i, j)], level);
+        bits[0] = esc_mask(r, ESC_V(i + 1, j));
+        bits[1] = esc_reverse_bits(esc_mask(r, ESC_H(i, j)), level);
+        bits[2] = esc_reverse_bits(esc_mask(r, ESC_D(i, j)), level);
     } else {
         corner[0] = (int2)(i, j + 1);
         corner[1] = (int2)(i, j);
         corner[2] = (int2)(i + 1, j + 1);
-        bits[0] = esc_reverse_bits(g->masks[ESC_V(i, j)], level);
-        bits[1] = g->masks[ESC_H(i, j + 1)];
-        bits[2] = g->masks[ESC_D(i, j)];
+        bits[0] = esc_reverse_bits(esc_mask(r, ESC_V(i, j)), level);
+        bits[1] = esc_mask(r, ESC_H(i, j + 1));
+        bits[2] = esc_mask(r, ESC_D(i, j));
     }
 }
 
@@ -286,8 +304,8 @@ inline uint esc_triangle(__private const esc_patch *g, __private const int2 corn
 {
     if ((a.x == b.x && a.y == b.y) || (b.x == c.x && b.y == c.y) || (a.x == c.x && a.y == c.y))
         return 0;
-    uint ia = esc_index(g, esc_lattice(corner, g->n, a)), ib = esc_index(g, esc_lattice(corner, g->n, b));
-    uint ic = esc_index(g, esc_lattice(corner, g->n, c));
+    uint ia = esc_index(g, esc_lattice(corner, g->r.n, a)), ib = esc_index(g, esc_lattice(corner, g->r.n, b));
+    uint ic = esc_index(g, esc_lattice(corner, g->r.n, c));
     if (ia == ib || ib == ic || ia == ic)
         return 0;  /* a side on a collapsed edge */
     put_triangle(out, count, base, ia, ib, ic);
@@ -297,19 +315,21 @@ inline uint esc_triangle(__private const esc_patch *g, __private const int2 corn
 /* The zipper of esc.py coarse_triangle over the bands between consecutive active rows. */
 inline void esc_coarse_triangle(__private const esc_patch *g, int t, __global uint *out, uint *count, uint base)
 {
-    int2 corner[3];
+    int2 corner[3], upper[ESC_MAX_LEVEL + 3], lower[ESC_MAX_LEVEL + 3];  /* chains, right to left */
     uint bits[3];
     esc_coarse(g, t, corner, bits);
-    int n = g->n, a = 0;
+    int n = g->r.n, a = 0, upper_length = 1;
+    upper[0] = (int2)(0, 0);
     for (int b = 1; b <= n; ++b) {
         if (b < n && !(((bits[0] | bits[1]) >> (b - 1)) & 1u))
             continue;  /* an inactive row: its band merges with the next */
-        int upper_length = esc_chain_length(bits, a, n), lower_length = esc_chain_length(bits, b, n);
-        int u = esc_chain_point(bits, a, 0, n).x != a ? 1 : 0, w = 0;
+        int lower_length = esc_chain_length(bits, b, n);
+        for (int k = 0; k < lower_length; ++k)
+            lower[k] = esc_chain_point(bits, b, k, n);
+        int u = upper[0].x != a ? 1 : 0, w = 0;  /* a virtual right end: the lower chain's start */
         while (u < upper_length - 1 || w < lower_length - 1) {
             int advance_upper;
-            int2 next_upper = esc_chain_point(bits, a, min(u + 1, upper_length - 1), n);
-            int2 next_lower = esc_chain_point(bits, b, min(w + 1, lower_length - 1), n);
+            int2 next_upper = upper[min(u + 1, upper_length - 1)], next_lower = lower[min(w + 1, lower_length - 1)];
             if (w == lower_length - 1) {
                 advance_upper = 1;
             } else if (u == upper_length - 1) {
@@ -319,32 +339,33 @@ inline void esc_coarse_triangle(__private const esc_patch *g, int t, __global ui
                 int along_lower = (next_lower.x - next_lower.y) * next_upper.x;
                 advance_upper = along_upper != along_lower ? along_upper < along_lower : next_upper.x < next_lower.x;
             }
-            int2 lower_point = esc_chain_point(bits, b, w, n), upper_point = esc_chain_point(bits, a, u, n);
-            if (advance_upper) {
-                esc_triangle(g, corner, lower_point, upper_point, next_upper, out, count, base);
+            esc_triangle(g, corner, lower[w], upper[u], advance_upper ? next_upper : next_lower, out, count, base);
+            if (advance_upper)
                 ++u;
-            } else {
-                esc_triangle(g, corner, lower_point, upper_point, next_lower, out, count, base);
+            else
                 ++w;
-            }
         }
+        for (int k = 0; k < lower_length; ++k)  /* the lower chain is the next band's upper one */
+            upper[k] = lower[k];
+        upper_length = lower_length;
         a = b;
     }
 }
 
 inline void esc_setup(int4 f, int collapsed, __private esc_patch *g)
 {
-    esc_decode(f, g->masks);
-    g->n = esc_level(f) + 1;
-    g->m = 3 * g->n;
+    g->r = esc_read(f);
     g->collapsed = collapsed;
     g->ring[0] = 0;
-    for (int e = 0; e < 4; ++e)
-        g->ring[e + 1] = g->ring[e] + esc_count_edge(g->masks, g->n, e);
+    for (int e = 0; e < 4; ++e) {
+        g->edge_bits[e] = esc_edge_bits(&g->r, e);
+        g->ring[e + 1] = g->ring[e] + popcount(g->edge_bits[e]);
+    }
     int at = g->ring[4];
-    for (int y = 1; y < g->m; ++y) {
+    for (int y = 1; y < g->r.m; ++y) {
+        g->row_bits[y] = esc_row_bits(&g->r, y);
         g->rows[y] = at;
-        at += esc_count_row(g->masks, g->n, y);
+        at += popcount(g->row_bits[y]);
     }
 }
 

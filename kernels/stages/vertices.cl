@@ -24,8 +24,9 @@ __kernel void vertices(__global const float4 *controls, __global const int4 *fac
     float3 position, normal;
 
     __attribute__((opencl_unroll_hint))  /* e constant in each copy: the edge's data in registers */
-    for (int e = 0; e < PATTERN_EDGES; ++e)
-        for (int k = 0; k < PATTERN_EDGE_POINTS(f, e); ++k) {
+    for (int e = 0; e < PATTERN_EDGES; ++e) {
+        int ring_count = PATTERN_EDGE_POINTS(f, e);
+        for (int k = 0; k < ring_count; ++k) {
             edge_param t = pattern_ring_param(f, e, k);
             float3 x = pattern_edge_point(e, t);
             kind_eval(&patch, x, 0, &normal);  /* the normal; the position is the edge's */
@@ -33,6 +34,7 @@ __kernel void vertices(__global const float4 *controls, __global const int4 *fac
             put_vertex(out, at++, kind_boundary_point(&patch, e, (collapsed >> e) & 1 ? corner : t), normal, x.xy,
                        p, object);
         }
+    }
 
     int rows = pattern_rows(f);
     for (int j = 1; j <= rows; ++j) {
