@@ -35,7 +35,7 @@ __kernel void vertex_rows(__global const float4 *controls, __global const int4 *
     if (first_row == 0) {
         __attribute__((opencl_unroll_hint))
         for (int e = 0; e < PATTERN_EDGES; ++e)
-            for (int k = 0; k < factor_of(f, e); ++k) {
+            for (int k = 0; k < PATTERN_EDGE_POINTS(f, e); ++k) {  /* patterns/layout.h */
                 edge_param t = pattern_ring_param(f, e, k);
                 float3 x = pattern_edge_point(e, t);
                 kind_eval(&patch, x, 0, &normal);
@@ -45,14 +45,15 @@ __kernel void vertex_rows(__global const float4 *controls, __global const int4 *
             }
         first_row = 1;
     } else {
-        at += (ulong)(f.s0 + f.s1 + f.s2 + f.s3);  /* the ring (unused factor slots are 0) */
+        for (int e = 0; e < PATTERN_EDGES; ++e)  /* the ring */
+            at += (ulong)PATTERN_EDGE_POINTS(f, e);
         for (int j = 1; j < first_row; ++j)
             at += (ulong)(pattern_row(f, j) - 1);
     }
 
     for (int j = first_row; j <= last_row; ++j) {
         int steps = pattern_row(f, j);
-        if (forward_differencing) {
+        if (forward_differencing && PATTERN_UNIFORM_ROWS) {
             kind_row row;
             kind_row_begin(&patch, pattern_row_point(f, j, 0), pattern_row_point(f, j, steps), steps, &row);
             for (int i = 1; i < steps; ++i) {
