@@ -494,7 +494,7 @@ def _prepare_scene(args):
         too_fine = eps_below_float32(scene, args.eps)
         if too_fine:
             print(f"{PROG}: warning: {args.scene}: {too_fine}", file=sys.stderr)
-    if args.pixels is not None:  # per patch: the tolerance shrinks with depth (issue 9 item 3)
+    if args.pixels is not None and scene.camera is not None:  # per patch: shrinks with depth (issue 9 item 3)
         from cltess.bound import tolerances_below_float32
 
         too_fine = tolerances_below_float32(scene, pixels=args.pixels, sharp_edges=getattr(args, "sharp_edges", "straight"))

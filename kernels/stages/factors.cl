@@ -21,7 +21,7 @@ __kernel void factors(__global const float4 *source, __global float4 *controls, 
     tolerance_args tol = {eps, view, frustum, pixels, pixel_size};
     int flag = 0;
 #ifdef PATTERN_ESC
-    int4 f = esc_factors(source, p, tol, max_level, &flag);
+    int4 f = esc_factors(controls, p, tol, max_level, &flag);  /* the patches (source: the bound constants) */
 #else
     int4 f = kind_factors(source, controls, p, tol, max_factor, &flag);
 #endif
