@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# The GPU-machine runs of the issue benchmarks (issues 11-15) on NVIDIA OpenCL, one call of the
+# device tool each (a call may run 10 minutes):
+#
+#   bash bench/gpu_issues.sh OUTDIR speed      # bench/frame_loop.py, bench/semi_uniform.py
+#   bash bench/gpu_issues.sh OUTDIR patterns   # bench/silhouette.py, bench/sd2.py, bench/esc.py
+#
+# Expects in .whl/ the Python 3.12 manylinux x86_64 wheels of pyopencl and its dependencies,
+# mako, trimesh, tqdm (as bench/gpu_run.sh) and NVIDIA's OpenCL library in
+# /usr/local/nvidia/lib64.  Each benchmark gets its own time limit so that one slow table cannot
+# take the others with it; its output and exit code are in OUTDIR.
+set -u
+out=${1:?usage: bash bench/gpu_issues.sh OUTDIR speed|patterns}
+which=${2:?usage: bash bench/gpu_issues.sh OUTDIR speed|patterns}
+python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade --target /tmp/site .whl/*.whl || exit 1
+export PYTHONPATH=/tmp/site:$PWD PYTHONUNBUFFERED=1
+python3 -c "import cltess.kernels" 2>/dev/null || ln -s ../kernels cltess/kernels
+mkdir -p /tmp/icd
+echo /usr/local/nvidia/lib64/libnvidia-opencl.so.1 > /tmp/icd/nvidia.icd
+export OCL_ICD_VENDORS=/tmp/icd
+{ nvidia-smi -L; python3 -m cltess devices; } > "$out/machine-$which.txt" 2>&1
+run() {  # run NAME SECONDS COMMAND...
+  local name=$1 limit=$2; shift 2
+  local started=$SECONDS
+  timeout "$limit" "$@" > "$out/$name.txt" 2>&1
+  echo "$name rc=$? $((SECONDS - started)) s" | tee -a "$out/log.txt"
+}
+case $which in
+  speed)
+    run frame_loop 330 python3 bench/frame_loop.py --device nvidia --json "$out/frame_loop.json"
+    run semi_uniform 230 python3 bench/semi_uniform.py --device nvidia --json "$out/semi_uniform.json" ;;
+  patterns)
+    run silhouette 200 python3 bench/silhouette.py --device nvidia --quality --json "$out/silhouette.json"
+    run sd2 150 python3 bench/sd2.py --device nvidia --json "$out/sd2.json"
+    run esc 200 python3 bench/esc.py --device nvidia --json "$out/esc.json" --csv "$out/esc.csv" ;;
+esac
