@@ -34,7 +34,7 @@ from ...patterns.semi_uniform import level_histogram
 from ...request import Request
 from ...scene import Camera, Scene
 from ...tessellation import Tessellation
-from .tessellator import Tessellator, _global_size, _span_ms
+from .tessellator import WORK_GROUP, Tessellator, _global_size, _span_ms
 
 #: The paper's typical maximum level M (section 5).
 DEFAULT_SILHOUETTE_LEVEL = 3
@@ -195,8 +195,11 @@ class SilhouetteRefiner:
         for part in plan.parts:
             if num_vertices:
                 kernel = tess.programs.kernel("silhouette_vertices", kind=part.kind, pattern=part.pattern)
+                # An explicit work-group size: PoCL otherwise picks large groups whose work-items'
+                # private state (this kernel's is large) overflowed its thread stack (segfaults
+                # from about 5k patches on).
                 events["vertices"].append(kernel(
-                    queue, _global_size(part.count), None, part.data["controls"].data, self._records.data,
+                    queue, _global_size(part.count), (WORK_GROUP,), part.data["controls"].data, self._records.data,
                     vertex_offsets.data, plan.objects.data, self._levels.data, np.uint32(part.base),
                     np.uint32(part.count), np.uint32(part.base), np.uint64(0), np.int32(blend),
                     *(a.data for a in vertices.values()), lod.data))
