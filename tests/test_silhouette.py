@@ -229,6 +229,20 @@ def test_non_integer_levels_blend_between_the_two(refiner):
     assert np.abs(p[0] - p[2]).max() > 1e-3
 
 
+@pytest.mark.parametrize("level", [1, 2, 3])
+def test_levels_just_below_an_integer_approach_it(refiner, level):
+    """S_{m+1-} -> S_{m+1}: s = level - h has the topology of s = level (ceil), and its vertices
+    move to level's in proportion to h."""
+    groups = refiner.edges.num_groups
+    at = refiner.frame([0, 0, 5.0], alpha=np.full(groups, np.float32(level) / np.float32(M))).tessellation
+    gaps = []
+    for h in (1e-2, 1e-3):
+        below = refiner.frame([0, 0, 5.0], alpha=np.full(groups, np.float32((level - h) / M))).tessellation
+        assert np.array_equal(below.triangles, at.triangles)
+        gaps.append(np.abs(below.positions - at.positions).max())
+    assert 0 < gaps[1] < 0.2 * gaps[0]
+
+
 # --- topology ----------------------------------------------------------------------------------------
 
 def closed_scenes(rng):
