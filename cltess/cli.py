@@ -296,6 +296,9 @@ def build_parser() -> argparse.ArgumentParser:
                              "level M (default 3) where the surface turns away from the eye, 0 far from "
                              "it, watertight (semi-uniform snap); every edge keeps at least --eps's level "
                              "unless --no-bound; the scene's camera without --camera-path")
+    frames.add_argument("--centre", choices=("pn", "average"),
+                        help="--silhouette, meshes: the PN centre control point, PN's (eq. 4, default) or "
+                             "the mean of the six edge points (eq. 5 of Dyken et al. 2008: flatter)")
     frames.add_argument("--no-bound", action="store_true",
                         help="--silhouette: levels from the silhouettes alone (the paper), --eps not kept")
     frames.add_argument("--phi", type=_phi, metavar="DEG",

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 #: Options that belong to --silhouette.
-SILHOUETTE_ONLY = ("phi", "no_blend", "no_snap", "no_bound")
+SILHOUETTE_ONLY = ("phi", "no_blend", "no_snap", "no_bound", "centre")
 
 
 class FramesError(ValueError):
@@ -102,7 +102,8 @@ def run_frames(args, scene, cameras, tessellator, weld: bool, say) -> list[dict]
 
         refiner = SilhouetteRefiner(tessellator, scene, max_level=args.silhouette, phi=args.phi,
                                     eps=None if args.no_bound else args.eps,
-                                    blend=not args.no_blend, snap=not args.no_snap, **mesh_options)
+                                    blend=not args.no_blend, snap=not args.no_snap, centre=args.centre or "pn",
+                                    **mesh_options)
         say(f"prepared once: {refiner.prepare_ms:.1f} ms (stages 1-3, edge data)")
         produce = lambda camera: refiner.frame(camera)  # noqa: E731
     else:

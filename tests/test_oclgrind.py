@@ -136,15 +136,16 @@ def test_no_oclgrind_reports(oclgrind, tmp_path_factory, pass_name, name):
         pytest.skip(run.results[name]["skipped"])
     found = problems(run, name)
     if pass_name == "uninitialized" and name in scenarios.SILHOUETTE:
-        # Known, not understood: the plugin reports silhouette_levels's use of the alpha that
-        # silhouette_alpha wrote, for edge groups from the scene's patch count on, although the
-        # inputs read clean and the values equal the NumPy reference on Oclgrind (notes/issue12).
-        # Only that report is let through; anything else, or its absence, fails.
+        # Known, not understood, and not every run: the plugin reported silhouette_levels's use of
+        # the alpha that silhouette_alpha wrote, for edge groups from the scene's patch count on,
+        # although the inputs read clean and the values equal the NumPy reference on Oclgrind
+        # (notes/issue12); in a run of all scenarios it did not.  Only that report is let through.
         other = [r for r in found if "Kernel: silhouette_levels" not in r
                  or not r.startswith("Controlflow depends on uninitialized value")]
         assert not other, f"{len(other)} Oclgrind reports in {pass_name}/{name}:\n{shown(other)}"
-        assert found, "the silhouette_levels report is gone: remove this exception"
-        pytest.xfail("Oclgrind's uninitialised-value plugin on silhouette_alpha's output (see the comment)")
+        if found:
+            pytest.xfail("Oclgrind's uninitialised-value plugin on silhouette_alpha's output (see the comment)")
+        return
     assert not found, f"{len(found)} Oclgrind reports in {pass_name}/{name}:\n{shown(found)}"
 
 

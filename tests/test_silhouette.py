@@ -229,6 +229,20 @@ def test_non_integer_levels_blend_between_the_two(refiner):
     assert np.abs(p[0] - p[2]).max() > 1e-3
 
 
+@pytest.mark.parametrize("level", [1, 2, 3])
+def test_levels_just_below_an_integer_approach_it(refiner, level):
+    """S_{m+1-} -> S_{m+1}: s = level - h has the topology of s = level (ceil), and its vertices
+    move to level's in proportion to h."""
+    groups = refiner.edges.num_groups
+    at = refiner.frame([0, 0, 5.0], alpha=np.full(groups, np.float32(level) / np.float32(M))).tessellation
+    gaps = []
+    for h in (1e-2, 1e-3):
+        below = refiner.frame([0, 0, 5.0], alpha=np.full(groups, np.float32((level - h) / M))).tessellation
+        assert np.array_equal(below.triangles, at.triangles)
+        gaps.append(np.abs(below.positions - at.positions).max())
+    assert 0 < gaps[1] < 0.2 * gaps[0]
+
+
 # --- topology ----------------------------------------------------------------------------------------
 
 def closed_scenes(rng):
@@ -417,3 +431,27 @@ def test_the_silhouette_programs_build_under_both_standards(standard):
                     cl.Program(context, source).build(options=options + [f"-cl-std={standard}"])
                 except cl.RuntimeError as error:
                     pytest.fail(f"{stage} ({kind.name}) fails as {standard} on {info.name}:\n{error}")
+
+
+def test_the_average_centre_of_eq_5(tessellator, sphere, rng):
+    """centre="average": b111 is the mean of the six edge control points (eq. 5), every other
+    control point bitwise PN's, the patch flatter, the frames still closed."""
+    eq4 = SilhouetteRefiner(tessellator, sphere, max_level=M)
+    eq5 = SilhouetteRefiner(tessellator, sphere, max_level=M, centre="average")
+    a, b = (r.plan.parts[0].data["controls"].get() for r in (eq4, eq5))
+    keep = [k for k in range(16) if k != 9]
+    assert np.array_equal(a[:, keep], b[:, keep])
+    assert np.abs(b[:, 9, :3] - b[:, 3:9, :3].mean(axis=1)).max() < 1e-6
+    corners = a[:, :3, :3].astype(np.float64)
+    normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    height = lambda c: np.abs(((c[:, 9, :3] - corners.mean(axis=1)) * normal).sum(1))  # noqa: E731
+    assert (height(b) < height(a)).all()
+    from cltess.kinds.pn import with_centre
+    source = with_centre(PN.prepare(sphere).source, "average")
+    assert np.abs(pn_control_points(source.astype(np.float64))[:, :10, :3] - b[:, :10, :3]).max() < 1e-6
+    for eye in random_eyes(rng, 2):
+        welded = eq5.frame(eye).tessellation.welded()
+        assert welded.stats["welded_boundary_edges"] == 0 and welded.stats["welded_t_junctions"] == 0
+    with pytest.raises(ValueError, match="centre"):
+        SilhouetteRefiner(tessellator, sphere, centre="flat")

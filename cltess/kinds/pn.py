@@ -22,6 +22,21 @@ from ..surfaces import pn as surface
 from ..surfaces.pn import pn_control_points, pn_folded
 from .base import FLAG_CULLED, FLAG_FOLDED, KindInput, PatchKind
 
+#: The centre control point b111 (Dyken, Reimers and Seland 2008, section 4): "pn" Vlachos'
+#: E + (E - V) / 2 (their eq. 4), "average" the mean E of the six edge control points (eq. 5,
+#: slightly flatter); chosen per triangle by the source's row 3 w (1: average).
+CENTRE_RULES = ("pn", "average")
+
+
+def with_centre(source: np.ndarray, centre: str) -> np.ndarray:
+    """A copy of PN source rows (T, 12, 4) with the centre rule ``centre`` (CENTRE_RULES)."""
+    if centre not in CENTRE_RULES:
+        raise ValueError(f"centre must be one of {', '.join(CENTRE_RULES)}, got {centre!r}")
+    out = np.array(source, np.float32)
+    out[:, 3, 3] = 1.0 if centre == "average" else 0.0
+    return out
+
+
 #: How ``pn_edge_normals`` treats a sharp edge (different normals on its two sides); "crease":
 #: ``pn_crease_ends``.
 SHARP_EDGE_MODES = ("straight", "average", "keep", "crease")

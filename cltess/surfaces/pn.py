@@ -77,7 +77,8 @@ def pn_control_points(triangles: np.ndarray) -> np.ndarray:
         out[:, 13 + e, :3] = _unit_or_zero(N[:, e] + N[:, (e + 1) % 3] - v * d)
     mean_edge = out[:, 3:9, :3].mean(axis=1)
     centre = P.mean(axis=1)
-    out[:, 9, :3] = mean_edge + (mean_edge - centre) / 2
+    average = triangles[:, 3, 3:] != 0  # eq. 5 of Dyken et al. 2008 (kinds/pn.py PN_AVERAGE_CENTRE)
+    out[:, 9, :3] = np.where(average, mean_edge, mean_edge + (mean_edge - centre) / 2)
     out[:, 10:13, :3] = N
     return out
 

@@ -49,7 +49,8 @@ inline float3 pn_mid_normal(float3 p_i, float3 p_j, float3 n_i, float3 n_j)
  * normals N1 N2 N3 (the normal field), in[6..11] the normals each boundary curve uses at its two
  * ends, edge e at in[6 + 2e] (start, corner e) and in[7 + 2e] (end, corner e+1): the vertex
  * normals, or 0 for a straight edge, or the average over the triangles at a sharp edge
- * (cltess/kinds/pn.py, pn_edge_normals). */
+ * (cltess/kinds/pn.py, pn_edge_normals; w = 1: a crease end, pn_end_control).  in[3].w = 1
+ * chooses the centre control point of eq. 5 (cltess/kinds/pn.py PN_AVERAGE_CENTRE). */
 inline void pn_control_points(const float4 in[12], float4 b[16])
 {
     for (int c = 0; c < 3; ++c)
@@ -66,7 +67,9 @@ inline void pn_control_points(const float4 in[12], float4 b[16])
     }
     float3 mean_edge = sum / 6.0f;
     float3 centre = (in[0].xyz + in[1].xyz + in[2].xyz) / 3.0f;
-    b[9] = (float4)(mean_edge + (mean_edge - centre) / 2.0f, 1.0f);
+    /* in[3].w = 1: the centre by eq. 5 of Dyken et al. 2008 (the mean of the six, flatter);
+     * else Vlachos' (their eq. 4) */
+    b[9] = (float4)(in[3].w != 0.0f ? mean_edge : mean_edge + (mean_edge - centre) / 2.0f, 1.0f);
     __attribute__((opencl_unroll_hint))
     for (int c = 0; c < 3; ++c) {
         b[10 + c] = (float4)(in[3 + c].xyz, 0.0f);

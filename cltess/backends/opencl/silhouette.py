@@ -28,13 +28,14 @@ import pyopencl.array as cl_array
 from ...criteria.silhouette import EdgeSilhouetteData, check_phi, edge_silhouette_data
 from ...criteria.tolerance import ObjectSpace
 from ...crack.adjacency import merge_edge_groups
-from ...kinds import FACTOR_SLOTS, KINDS
+from ...kinds import FACTOR_SLOTS, KINDS, PN
+from ...kinds.pn import CENTRE_RULES, with_centre
 from ...limits import check_totals
 from ...patterns.semi_uniform import level_histogram
 from ...request import Request
 from ...scene import Camera, Scene
 from ...tessellation import Tessellation
-from .tessellator import Tessellator, _global_size, _span_ms
+from .tessellator import WORK_GROUP, Tessellator, _global_size, _span_ms
 
 #: The paper's typical maximum level M (section 5).
 DEFAULT_SILHOUETTE_LEVEL = 3
@@ -72,12 +73,16 @@ class SilhouetteRefiner:
     alone.  blend: eq. 9 (False: each vertex at its level ceil(s), the popping ablation).  snap:
     the semi-uniform snap (False: every edge of a patch at its level m, the paper's hanging
     nodes).  sharp_edges: the PN sharp-edge mode.  recompute_controls: rerun stage 1 per frame.
+    centre: PN's centre control point, "pn" (eq. 4, Vlachos') or "average" (eq. 5, the mean of
+    the six edge points: flatter).
     """
 
     def __init__(self, tessellator: Tessellator, scene: Scene, max_level: int = DEFAULT_SILHOUETTE_LEVEL,
                  phi: float | None = None, eps: float | None = None, blend: bool = True, snap: bool = True,
-                 sharp_edges: str = "straight", recompute_controls: bool = False):
+                 sharp_edges: str = "straight", recompute_controls: bool = False, centre: str = "pn"):
         check_phi(phi)
+        if centre not in CENTRE_RULES:
+            raise ValueError(f"centre must be one of {', '.join(CENTRE_RULES)}, got {centre!r}")
         self.tessellator, self.scene = tessellator, scene
         self.max_level, self.phi, self.eps = int(max_level), phi, eps
         self.blend, self.snap, self.recompute_controls = bool(blend), bool(snap), bool(recompute_controls)
@@ -101,6 +106,8 @@ class SilhouetteRefiner:
         hosts = [scene.prepared((kind.name, sharp_edges), lambda kind=kind: kind.prepare(scene, sharp_edges))
                  for kind in kinds]
         count = self.plan.num_patches
+        self._scratch_factors = cl_array.empty(queue, (count, FACTOR_SLOTS), np.int32)
+        self._scratch_flags = cl_array.empty(queue, count, np.int32)
         groups = scene.prepared(("edge groups", sharp_edges), lambda: merge_edge_groups(
             [(host.groups, part.kind.edges, part.base) for host, part in zip(hosts, self.plan.parts)],
             count, FACTOR_SLOTS))
@@ -116,12 +123,19 @@ class SilhouetteRefiner:
         self._mids, self._normals, self._rules, self._group_of = (
             cl_array.to_device(queue, a) for a in (mids, normals, rules, groups.group_of.astype(np.int32)))
         self.groups, self.group_of = groups, groups.group_of
+        if centre != "pn":  # eq. 5: PN sources flagged, stages 1-2 again (controls and bound)
+            for host, part in zip(hosts, self.plan.parts):
+                if part.kind is PN:
+                    part.data["source"].set(with_centre(host.source, centre))
+            for part in self.plan.parts:
+                tessellator.stage_factors_of(part.kind, part.data, self.request.tolerance_for(scene),
+                                             self.request.max_factor, self._scratch_factors, self._scratch_flags,
+                                             part.base, part.pattern, self.max_level)
+            self.plan.factors, _ = tessellator.stage_crack_free(self._scratch_factors, groups)
         self._alpha = cl_array.empty(queue, max(self.edges.num_groups, 1), np.float32)
         self._levels = cl_array.empty(queue, (count, FACTOR_SLOTS), np.float32)
         self._patch_records = cl_array.empty(queue, (count, FACTOR_SLOTS), np.int32)
         self._records = cl_array.empty(queue, (count, FACTOR_SLOTS), np.int32)
-        self._scratch_factors = cl_array.empty(queue, (count, FACTOR_SLOTS), np.int32)
-        self._scratch_flags = cl_array.empty(queue, count, np.int32)
         queue.finish()
         self.prepare_ms = (time.perf_counter() - started) * 1e3
 
@@ -195,8 +209,11 @@ class SilhouetteRefiner:
         for part in plan.parts:
             if num_vertices:
                 kernel = tess.programs.kernel("silhouette_vertices", kind=part.kind, pattern=part.pattern)
+                # An explicit work-group size: PoCL otherwise picks large groups whose work-items'
+                # private state (this kernel's is large) overflowed its thread stack (segfaults
+                # from about 5k patches on).
                 events["vertices"].append(kernel(
-                    queue, _global_size(part.count), None, part.data["controls"].data, self._records.data,
+                    queue, _global_size(part.count), (WORK_GROUP,), part.data["controls"].data, self._records.data,
                     vertex_offsets.data, plan.objects.data, self._levels.data, np.uint32(part.base),
                     np.uint32(part.count), np.uint32(part.base), np.uint64(0), np.int32(blend),
                     *(a.data for a in vertices.values()), lod.data))
