@@ -150,10 +150,11 @@ class Tessellator:
         final, events["crack_free"] = self.stage_crack_free(factors, groups)
         vertex_offsets, index_offsets, events["counts"] = self.stage_counts(
             final, [(part.pattern, part.base, part.count) for part in parts])
-        strips = strip_offsets(self, final, parts) if strip_parts(parts) else (None, 0, [])
-        events["counts"] += strips[2]
-        num_vertices = int(vertex_offsets[count].get())  # the two read-backs
+        strips = strip_offsets(self, final, parts) if strip_parts(parts) else (None, [])
+        events["counts"] += strips[1]
+        num_vertices = int(vertex_offsets[count].get())  # the two read-backs (three with strips)
         num_indices = int(index_offsets[count].get())
+        num_strip_indices = int(strips[0][count].get()) if strips[0] is not None else 0
         check_totals(scene.name, num_vertices)
         flag_values = flags.get()
         stats = {
@@ -176,7 +177,7 @@ class Tessellator:
                 [read_back["factors"][p.base:p.base + p.count] for p in parts if p.pattern.dyadic]))
         return Plan(scene.name, count, parts, objects, final, vertex_offsets, index_offsets,
                     num_vertices, num_indices, stats, events, started, request, _host=read_back,
-                    strip_offsets=strips[0], num_strip_indices=strips[1])
+                    strip_offsets=strips[0], num_strip_indices=num_strip_indices)
 
     def upload(self, kind: PatchKind, source: np.ndarray) -> dict:
         """Device arrays of a kind: "source" (one row per patch) for stage 1, "controls" what
