@@ -96,7 +96,8 @@ class Tessellator:
         ``max_factor``, ``forward_differencing``, ``sharp_edges`` (meshes only: "straight",
         "average" or "keep", ``cltess.kinds.pn.pn_edge_normals``; only "keep" may leave cracks),
         ``pattern`` ("semi_uniform", "transition" or a pattern's name) and ``max_level`` (the
-        semi-uniform patterns' largest level, default 6).
+        semi-uniform patterns' largest level, default 6); for pattern "sd2" ``level_function``,
+        ``level_factors``, ``depth_map``, ``depth_range``, ``camera`` (``Request``, docs/sd2.md).
         """
         plan = self.plan(scene, request, **options)
         return self.emit(plan, 0, plan.num_patches)
