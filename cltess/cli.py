@@ -723,9 +723,9 @@ def _warn_saturated(saturated: int, args) -> None:
     if saturated:
         patches = "1 patch reaches" if saturated == 1 else f"{saturated} patches reach"
         verb = "does" if saturated == 1 else "do"
-        cap = f"--max-factor {args.max_factor}" if args.pattern == "transition" else \
+        cap = f"--max-factor {args.max_factor}" if args.pattern != "semi-uniform" else \
             f"--max-factor {args.max_factor} or 2^--max-level {args.max_level}"
-        raise_it = "--max-factor" if args.pattern == "transition" else "them"
+        raise_it = "--max-factor" if args.pattern != "semi-uniform" else "them"
         print(f"{PROG}: warning: {patches} {cap} and {verb} not meet the error bound; raise {raise_it}",
               file=sys.stderr)
 

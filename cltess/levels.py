@@ -107,3 +107,27 @@ def level_factors(function: str, corners, values, depth_map: str = "linear", nea
     if function == "silhouette":
         return np.where(a != b, round(high * FIXED_ONE), round(low * FIXED_ONE)).astype(np.int64)
     return (np.maximum(a, b) * FIXED_ONE).astype(np.int64)
+
+
+def reference_level_factors(scene, request, stage1: np.ndarray) -> tuple[np.ndarray, dict]:
+    """The NumPy backend's level-function stage: (T, 4) fixed-point factors of the scene's PN
+    triangles from their stage-1 factors ``stage1`` (T, 4) (culled and folded: 0 stays 0), as
+    cltess/backends/opencl/level_functions.py computes them; and the stats it reports."""
+    function = request.sd2_level_function
+    corners, positions, normals = welded_corners(scene)
+    low, high = (float(x) for x in request.level_factors)
+    stats = {"level_function": function}
+    near, far = 0.0, 0.0
+    if function == "bound":
+        values = vertex_bounds(corners, stage1)
+    else:
+        values = vertex_levels(function, positions, normals, request.camera or scene.camera)
+        if function == "depth":
+            near, far = request.depth_range if request.depth_range is not None else \
+                (float(values.min()), float(values.max()))
+            stats["depth_range"] = (near, far)
+    fixed = level_factors(function, corners, values, request.depth_map, near, far, low, high)
+    out = np.zeros((len(corners), 4), np.int64)
+    live = np.asarray(stage1)[:, 0] > 0
+    out[live, :3] = fixed[live]
+    return out.astype(np.int32), stats

@@ -35,7 +35,8 @@ def test_device_strips_equal_the_mirror_and_the_closed_forms(tessellator, rng):
     vertex_offsets, index_offsets, _ = tessellator.stage_counts(device, [(SD2, 0, count)])
     part = SimpleNamespace(pattern=SD2, base=0, count=count)
     from cltess.backends.opencl.strips import emit_strips, strip_offsets
-    offsets, total, _ = strip_offsets(tessellator, device, [part])
+    offsets, _ = strip_offsets(tessellator, device, [part])
+    total = int(offsets[count].get())
     closed = np.array([sd2_counts(f) for f in factors])
     assert np.array_equal(np.diff(vertex_offsets.get()), closed[:, 0])
     assert np.array_equal(np.diff(index_offsets.get()), 3 * closed[:, 1])
@@ -215,3 +216,26 @@ def test_the_sd2_stage_programs_build_under_both_standards(standard):
         for stage in ("strip_counts", "strip_indices", "vertex_levels", "vertex_bounds", "level_factors"):
             source, options = program_text(stage, *composition(stage, pattern=SD2))
             cl.Program(context, source).build(options=options + [f"-cl-std={standard}"])
+
+
+@pytest.mark.parametrize("function", ["bound", "silhouette", "depth"])
+def test_the_numpy_backend_agrees(tessellator, rng, function):
+    """The NumPy backend's SD-2 (cltess.levels.reference_level_factors, the pattern's mirror)
+    against the OpenCL one on a scene of both kinds: factors, triangles, strips, positions."""
+    from cltess.backends.numpy import NumpyBackend
+    from cltess.request import Request
+    from cltess.criteria import ObjectSpace
+    from support import closed_torus_grid
+
+    grid = closed_torus_grid(rng, 4, 3)
+    mesh = icosphere(1)
+    scene = Scene(grid.patches, grid.object_ids, name="mixed", meshes=mesh.meshes)
+    request = Request(ObjectSpace(0.02), pattern="sd2", level_function=function, camera=CAMERA,
+                      depth_range=(2.0, 4.0) if function == "depth" else None, level_factors=(1.5, 6.0))
+    device, host = tessellator.tessellate(scene, request), NumpyBackend().tessellate(scene, request)
+    if function == "depth":  # float32 map against float64: a fixed-point ulp or two
+        assert np.abs(device.real_factors - host.real_factors).max() < 1e-4
+        return
+    for name in ("factors", "real_factors", "triangles", "strips"):
+        assert np.array_equal(getattr(device, name), getattr(host, name)), name
+    assert np.allclose(device.positions, host.positions, atol=1e-5)

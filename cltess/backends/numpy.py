@@ -101,6 +101,30 @@ class NumpyPlan:
         return int(self.index_offsets[-1])
 
 
+def _fractional_output(plan, first: int, last: int):
+    """(factors: segments, real factors, strips) of patches first..last-1 where a pattern is
+    fractional (SD-2; as the OpenCL backend's Plan.output_factors and strip emission)."""
+    from ..patterns.fractional import FIXED_ONE, odd_segments
+    from ..patterns.sd2 import sd2_strip_indices
+    from ..strips import STRIP_RESTART
+
+    factors = plan.factors[first:last].copy()
+    real = factors.astype(np.float32)
+    strips = []
+    for _, pattern, base, count, _ in plan.parts:
+        lo, hi = max(first, base), min(last, base + count)
+        if lo >= hi or not pattern.fixed_point:
+            continue
+        for p in range(lo, hi):
+            row = plan.factors[p]
+            real[p - first] = row / np.float32(FIXED_ONE)
+            factors[p - first] = [odd_segments(x) if x > 0 else 0 for x in row]
+            local = sd2_strip_indices(row)
+            strips.append(np.where(local == STRIP_RESTART, local, local + plan.vertex_offsets[p]))
+    strips = np.concatenate(strips).astype(np.uint32) if strips else np.zeros(0, np.uint32)
+    return factors, real, strips[:-1] if len(strips) else strips
+
+
 class NumpyBackend:
     """``plan(scene, request)`` and ``emit(plan, first, last)`` in NumPy (cltess.backends.base)."""
 
@@ -124,6 +148,9 @@ class NumpyBackend:
                 f, fl = dyadic_stage(f, fl, request.max_level)
             if pattern.stage1:  # the pattern's own stage 1 (ESC: candidate masks)
                 f, fl = pattern.stage1[1](controls, request.tolerance_for(scene), request.max_level)
+            if pattern.fixed_point:  # a level function's fixed-point factors (SD-2)
+                from ..levels import reference_level_factors
+                f, level_stats = reference_level_factors(scene, request, f)
             parts.append((kind, pattern, base, count, controls))
             inputs.append(host)
             factors.append(f)
@@ -140,6 +167,8 @@ class NumpyBackend:
             vertex_counts[b:b + count], index_counts[b:b + count] = pattern.counts(final[b:b + count])
         stats = {"patches": base, "culled": int(np.count_nonzero(flags & FLAG_CULLED)),
                  "saturated": int(np.count_nonzero(flags & FLAG_SATURATED))}
+        if any(pattern.fixed_point for _, pattern, _, _, _ in parts):
+            stats.update(level_stats)
         if any(pattern.dyadic for _, pattern, _, _, _ in parts):
             stats["patch_levels"] = level_histogram(np.concatenate(
                 [final[b:b + count] for _, pattern, b, count, _ in parts if pattern.dyadic]))
@@ -161,6 +190,10 @@ class NumpyBackend:
                   if pieces else np.zeros((0, *shape), dtype) for name, dtype, shape in VERTEX_RECORD}
         triangles = np.concatenate([p["triangles"] for p in pieces]).astype(np.uint32) if pieces \
             else np.zeros((0, 3), np.uint32)
-        return Tessellation(triangles=triangles.reshape(-1, 3), factors=plan.factors[first:last],
+        factors, real_factors, strips = plan.factors[first:last], None, None
+        if any(pattern.fixed_point for _, pattern, _, _, _ in plan.parts):
+            factors, real_factors, strips = _fractional_output(plan, first, last)
+        return Tessellation(triangles=triangles.reshape(-1, 3), factors=factors, strips=strips,
+                            real_factors=real_factors,
                             stage_ms={"total_wall": (time.perf_counter() - started) * 1e3},
                             stats=dict(plan.stats, first_patch=first, last_patch=last), **arrays)

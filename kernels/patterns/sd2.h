@@ -6,8 +6,9 @@
  * Per patch, by its factors: two equal and one different, the SD-2 fan-and-bands with its tip
  * where the equal edges meet; all equal, the regular grid; all different, the transition
  * pattern on the segment counts (patterns/tri_transition.h, included here under other names).
- * One walk (sd2_walk) gives the triangle strips, the triangles (the strips expanded), and in
- * count mode their numbers: stage 3 counts with it, stage 5 and stages/strip_indices.cl emit. */
+ * One walk (sd2_walk) gives the triangle strips and the triangles (the strips expanded): stage 5
+ * and stages/strip_indices.cl emit with it; stage 3 counts the fan and the grid in closed form
+ * (sd2_closed_counts, tested equal to the walk) and the transition fallback by its walk. */
 #ifndef CLTESS_PATTERNS_SD2_H
 #define CLTESS_PATTERNS_SD2_H
 #include "common.h"
@@ -218,9 +219,33 @@ inline void sd2_walk(int4 f, int collapsed, __private strip_writer *w)
     }
 }
 
+/* Count mode of the fan and the grid in closed form (docs/sd2.md section 3; the walk's own
+ * counts, as tests/test_sd2_pipeline.py checks): *triangles and *strip_indices; 0 for the
+ * transition fallback and culled patches, which the walk counts. */
+inline int sd2_closed_counts(int4 f, uint *triangles, uint *strip_indices)
+{
+    int tip, shape = sd2_shape(f, &tip);
+    if (shape == SD2_FAN) {
+        uint a = (uint)sd2_segments(f, tip), b = (uint)sd2_segments(f, (tip + 1) % 3);
+        *triangles = b * (2 * a - 1);
+        *strip_indices = b * (2 * a + 2);
+        return 1;
+    }
+    if (shape == SD2_GRID) {
+        uint n = (uint)sd2_segments(f, 0);
+        *triangles = n * n;
+        *strip_indices = n * n + 3 * n;
+        return 1;
+    }
+    return 0;
+}
+
 /* Triangles ("count" mode when out == 0, "emit" otherwise): the strips expanded. */
 inline uint pattern_primitives(int4 f, int collapsed, __global uint *out, uint base)
 {
+    uint triangles, strip_indices;
+    if (!out && sd2_closed_counts(f, &triangles, &strip_indices))
+        return triangles;
     strip_writer w = {0, out, base, 0, 0, 0, 0, 0};
     sd2_walk(f, collapsed, &w);
     return w.triangle_count;
@@ -229,6 +254,9 @@ inline uint pattern_primitives(int4 f, int collapsed, __global uint *out, uint b
 /* Strip indices, each strip followed by STRIP_RESTART (count mode when out == 0). */
 inline uint pattern_strips(int4 f, int collapsed, __global uint *out, uint base)
 {
+    uint triangles, strip_indices;
+    if (!out && sd2_closed_counts(f, &triangles, &strip_indices))
+        return strip_indices;
     strip_writer w = {out, 0, base, 0, 0, 0, 0, 0};
     sd2_walk(f, collapsed, &w);
     return w.strip_count;

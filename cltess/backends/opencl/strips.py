@@ -24,9 +24,9 @@ def strip_parts(parts) -> list:
     return [part for part in parts if part.pattern.primitive == "strips"]
 
 
-def strip_offsets(tessellator, factors, parts) -> tuple[cl_array.Array, int, list]:
+def strip_offsets(tessellator, factors, parts) -> tuple[cl_array.Array, list]:
     """(offsets (P+1,) uint64 of the strip indices of every patch, 0 for the patches of other
-    patterns; the total; events) from the final factors."""
+    patterns, the total last; events) from the final factors."""
     queue, programs = tessellator.queue, tessellator.programs
     count = len(factors)
     counts = cl_array.zeros(queue, count, np.uint64)
@@ -35,7 +35,7 @@ def strip_offsets(tessellator, factors, parts) -> tuple[cl_array.Array, int, lis
         queue, _global_size(part.count), None, factors.data, np.uint32(part.count), np.uint32(part.base),
         counts.data) for part in strip_parts(parts) if part.count]
     events.append(programs.offsets_scan(counts, offsets))
-    return offsets, int(offsets[count].get()), events
+    return offsets, events
 
 
 def emit_strips(tessellator, plan, first: int, last: int) -> tuple[np.ndarray, list]:

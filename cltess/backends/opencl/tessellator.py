@@ -103,7 +103,8 @@ class Tessellator:
         ``max_factor``, ``forward_differencing``, ``sharp_edges`` (meshes only: "straight",
         "average" or "keep", ``cltess.kinds.pn.pn_edge_normals``; only "keep" may leave cracks),
         ``pattern`` ("semi_uniform", "transition" or a pattern's name) and ``max_level`` (the
-        semi-uniform patterns' largest level, default 6).
+        semi-uniform patterns' largest level, default 6); for pattern "sd2" ``level_function``,
+        ``level_factors``, ``depth_map``, ``depth_range``, ``camera`` (``Request``, docs/sd2.md).
         """
         plan = self.plan(scene, request, **options)
         return self.emit(plan, 0, plan.num_patches)
@@ -190,8 +191,8 @@ class Tessellator:
         scratch["final"] = final
         vertex_offsets, index_offsets, events["counts"] = self.stage_counts(
             final, [(part.pattern, part.base, part.count) for part in parts], scratch=scratch)
-        strips = strip_offsets(self, final, parts) if strip_parts(parts) else (None, 0, [])
-        events["counts"] += strips[2]
+        strips = strip_offsets(self, final, parts) if strip_parts(parts) else (None, [])
+        events["counts"] += strips[1]
         totals = np.zeros(2, np.uint64)  # the two read-backs, and the flags, waited for at once
         flag_values = np.empty(count, np.int32)
         cl.wait_for_events([
@@ -199,6 +200,7 @@ class Tessellator:
             cl.enqueue_copy(self.queue, totals[1:], index_offsets.data, src_offset=8 * count, is_blocking=False),
             cl.enqueue_copy(self.queue, flag_values, flags.data, is_blocking=False)])
         num_vertices, num_indices = int(totals[0]), int(totals[1])
+        num_strip_indices = int(strips[0][count].get()) if strips[0] is not None else 0  # a third read-back
         check_totals(scene.name, num_vertices)
         stats = {
             "patches": count,
@@ -216,7 +218,7 @@ class Tessellator:
                 [read_back["factors"][p.base:p.base + p.count] for p in parts if p.pattern.dyadic]))
         return Plan(scene.name, count, parts, data.objects, final, vertex_offsets, index_offsets,
                     num_vertices, num_indices, stats, events, started, request, _host=read_back,
-                    strip_offsets=strips[0], num_strip_indices=strips[1])
+                    strip_offsets=strips[0], num_strip_indices=num_strip_indices)
 
     def upload_groups(self, groups, num_patches: int) -> dict:
         """Stage 2's edge groups (cltess.crack.adjacency.EdgeGroups over the P * 4 edge slots)
