@@ -4,8 +4,9 @@
  * all patches, kind after kind).  flags: FLAG_SATURATED (the bound is not met at max_factor, or
  * at 2^max_level), FLAG_CULLED, FLAG_FOLDED (common.h).  Built with -D PATTERN_DYADIC for a
  * dyadic pattern (semi-uniform): the factors are rounded up to 2^p_e here, before the crack-free
- * pass, for every kind alike (common.h dyadic_factors). */
-__kernel void factors(__global const float4 *source, __global float4 *controls, uint num_patches,
+ * pass, for every kind alike (common.h dyadic_factors).  source is writable for a kind that
+ * keeps per-patch constants there (PatchKind.per_patch_constants: the Bézier kind's bound). */
+__kernel void factors(__global float4 *source, __global float4 *controls, uint num_patches,
                       uint patch_base, float eps, float16 view, float4 frustum, float pixels,
                       float pixel_size, int max_factor, int max_level, __global int4 *factors,
                       __global int *flags)

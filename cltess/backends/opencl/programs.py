@@ -29,7 +29,6 @@ STAGE_AXES = {
     # stage 4 by level (levels.py), for a pattern with a template: built when it is asked for
     "level_vertices": ("kind", "pattern"),
     "verify": ("kind",),  # on request only (Tessellator.verify), so not in STAGES
-    "constants": ("kind",),  # once per scene for kinds with per_patch_constants (Tessellator.upload)
 }
 
 
@@ -98,8 +97,6 @@ class Programs:
         """Build (or find) every stage's program for one (kind, pattern, tolerance) now."""
         for stage in STAGES:
             self.kernel(stage, kind=kind, pattern=pattern, tolerance=tolerance)
-        if kind.per_patch_constants:  # run once per scene, before stage 1
-            self.kernel("constants", kind=kind)
 
     def build(self, stage: str, headers: tuple, defines: dict) -> cl.Program:
         source, options = program_text(stage, headers, defines)
