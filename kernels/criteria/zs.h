@@ -117,7 +117,7 @@ inline void convolve_wedge(const float4 a[16], const float4 b[16], float4 out[49
  * w^3 p_uv = w A_uv - w_u B_v - w_v B_u, w^3 p_vv likewise, A_ab = w X_ab - w_ab X,
  * B_a = w X_a - w_a X, all (9, 9) Bernstein nets); M_ab = max |H_k.ab|, and Lemma 3's alpha for
  * rho = M_vv / M_uu (0 when M_uu or M_vv is 0).  About 8,000 float4 multiply-adds per rational
- * patch: stage 1 does not call this, kernels/stages/constants.cl does, once per scene. */
+ * patch: stage 1 calls it once per patch and scene and keeps the result (kinds/bezier.h). */
 inline float4 zs_constants(const float4 b[16])
 {
     float3 lo = b[0].xyz / b[0].w, hi = lo;
@@ -220,12 +220,6 @@ inline float2 zs_constant_steps(float4 bound, float eps)
             step = diagonal;
     }
     return 1.0f / step;
-}
-
-/* The steps' inverses for a patch and tolerance eps in one go (zs_inverse_steps on the host). */
-inline float2 zs_inverse_steps(const float4 b[16], float eps)
-{
-    return zs_constant_steps(zs_constants(b), eps);
 }
 
 #endif
