@@ -1,18 +1,18 @@
 """Stage 1 of rational patches: the first call on a scene against the calls after it.
 
 The rational bound's constants (M_uu, M_uv, M_vv, alpha; docs/rational-bound.md) depend on the
-patch alone.  Since issue 9's follow-up they are made once per scene and context by
-kernels/stages/constants.cl and cached on the scene (``Tessellator.upload``); before, stage 1
-computed them per patch on every call.  This times, per scene (the ``cltess bench`` suite's,
-0.5 px with their cameras):
+patch alone.  Since issue 9's follow-up stage 1 makes them for each patch it sees on the first
+call and keeps them with the scene per context (``Tessellator.upload``); before, it computed
+them per patch on every call.  This times, per scene (the ``cltess bench`` suite's, 0.5 px with
+their cameras):
 
 - "first": the first ``tessellate`` of the scene object.  Programs are built and the scene's
   host preparation (adjacency, ``Scene.prepared``) is done beforehand, on a copy and on the
-  scene respectively, so that the figure is the pipeline itself: upload, the constants kernel
-  (where the code has one), the five stages and the read-back;
+  scene respectively, so that the figure is the pipeline itself: upload, the five stages
+  (stage 1 making the constants) and the read-back;
 - "later": the median of ``--repeat`` calls after it.
 
-Columns: "constants" and "factors" are device milliseconds from OpenCL profiling events,
+Columns: "factors" is device milliseconds from OpenCL profiling events,
 "end to end" the pipeline's ``total_wall`` (upload to read-back, host time included).  Runs on
 whatever ``cltess`` is importable, so the same script times another checkout (e.g. main,
 installed in its own virtual environment; run it from outside the checkout):
@@ -43,10 +43,10 @@ def time_scene(tessellator, spec, repeat: int) -> dict:
     first = tessellator.tessellate(scene, pixels=pixels)
     later = [tessellator.tessellate(scene, pixels=pixels) for _ in range(repeat)]
     median = lambda key: statistics.median(t.stage_ms.get(key, 0.0) for t in later)  # noqa: E731
-    return {"scene": spec.key, "patches": scene.num_patches, "triangles": first.num_triangles,
-            "first": {"constants": first.stage_ms.get("constants", 0.0), "factors": first.stage_ms["factors"],
-                      "end_to_end": first.stage_ms["total_wall"]},
-            "later": {"constants": median("constants"), "factors": median("factors"),
+    return {"scene": spec.key, "patches": scene.num_patches, "culled": int(first.stats["culled"]),
+            "triangles": first.num_triangles,
+            "first": {"factors": first.stage_ms["factors"], "end_to_end": first.stage_ms["total_wall"]},
+            "later": {"factors": median("factors"),
                       "end_to_end": median("total_wall"), "runs": [t.stage_ms for t in later]},
             "same_triangles": all(t.num_triangles == first.num_triangles for t in later)}
 
@@ -66,15 +66,15 @@ def main(argv=None) -> None:
     tessellator = Tessellator(args.device)
     device = tessellator.device.name.strip()
     print(f"cltess {cltess.__file__}, device {device}")
-    print("| scene | patches | triangles | first: constants / factors / end to end ms | "
+    print("| scene | patches | culled | triangles | first: factors / end to end ms | "
           "later (median): factors / end to end ms |")
-    print("|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|")
     results = []
     for key in args.scenes:
         r = time_scene(tessellator, SUITE[key], args.repeat)
         results.append(r)
         f, g = r["first"], r["later"]
-        print(f"| {key} | {r['patches']:,} | {r['triangles']:,} | {f['constants']:.2f} / {f['factors']:.2f} / "
+        print(f"| {key} | {r['patches']:,} | {r['culled']:,} | {r['triangles']:,} | {f['factors']:.2f} / "
               f"{f['end_to_end']:.1f} | {g['factors']:.2f} / {g['end_to_end']:.1f} |")
         sys.stdout.flush()
     if args.json:

@@ -55,7 +55,7 @@ def zs_inverse_steps(patch: np.ndarray, eps: float) -> tuple[float, float]:
 def zs_constants(patch: np.ndarray) -> tuple[float, float, float, float]:
     """(M_uu, M_uv, M_vv, alpha) of one (4, 4, 4) patch: the part of zs_inverse_steps that
     depends on the patch alone (mirror of kernels/criteria/zs.h, zs_constants, which the device
-    runs once per scene: kernels/stages/constants.cl).  Rational: the M's from
+    calls once per patch and scene, kernels/kinds/bezier.h).  Rational: the M's from
     second_derivative_hull, alpha = diagonal_majorant(hull, M_vv / M_uu) (0 where M_uu or M_vv
     is 0).  Equal weights: second_derivative_bounds and alpha = 0 (no Lemma 3)."""
     w = patch[..., 3]

@@ -43,10 +43,10 @@ class PatchKind:
     edges:   boundary curves per patch (at most FACTOR_SLOTS).
     header:  its device header under kernels/ (the kind contract of docs/extending.md).
     pattern: its default pattern (a ``cltess.patterns.Pattern`` of its domain).
-    per_patch_constants: whether stage 1 reads, as its source, one float4 per patch that its
-             header's ``kind_constants(controls, p)`` makes once per scene
-             (kernels/stages/constants.cl; cached per context, ``Tessellator.upload``): the part
-             of its bound that depends on the patch alone.  Stage 1 then reads the patches
+    per_patch_constants: whether stage 1 reads, as its source, one float4 per patch that it
+             makes itself on the patch's first visible call (``.x < 0``: not made yet) and keeps
+             there: the part of the kind's bound that depends on the patch alone, cached on the
+             scene per OpenCL context (``Tessellator.upload``).  Stage 1 then reads the patches
              from the controls.
     surface: its NumPy surface module (``cltess.surfaces.<kind>``): ``evaluate(controls, u, v)
              -> (positions, normals)`` of one patch and ``surface_points(controls, ids, u, v)``

@@ -1,7 +1,8 @@
 """Rational bicubic Bézier patches (docs/design.md section 2): the host side of
 kernels/kinds/bezier.h.  Source = controls = (P, 16, 4) homogeneous control points; on the
 device stage 1 reads them as controls and its source is the bound's constants, one float4 per
-patch made once per scene (per_patch_constants; criteria/zheng_sederberg.py, zs_constants)."""
+patch that stage 1 makes on first use and keeps with the scene (per_patch_constants;
+criteria/zheng_sederberg.py, zs_constants)."""
 from __future__ import annotations
 
 import numpy as np

@@ -85,6 +85,20 @@ inline void convolve_scaled(const float4 *a, int na, const float4 *b, int nb, fl
         }
 }
 
+/* out += a b for scalar scaled nets a of degree (na, na) and b of degree (nb, nb) (the weights'
+ * powers: convolve_scaled's .w alone, in the same order). */
+inline void convolve_weights(const float *a, int na, const float *b, int nb, float *out)
+{
+    int stride = na + nb + 1;
+    for (int j1 = 0; j1 <= na; ++j1)
+        for (int i1 = 0; i1 <= na; ++i1) {
+            float x = a[j1 * (na + 1) + i1];
+            for (int j2 = 0; j2 <= nb; ++j2)
+                for (int i2 = 0; i2 <= nb; ++i2)
+                    out[(j1 + j2) * stride + i1 + i2] += x * b[j2 * (nb + 1) + i2];
+        }
+}
+
 /* out += (a.w b.xyz - b.w a.xyz, 0) for scaled (3, 3) nets, out (6, 6). */
 inline void convolve_wedge(const float4 a[16], const float4 b[16], float4 out[49])
 {
@@ -103,7 +117,7 @@ inline void convolve_wedge(const float4 a[16], const float4 b[16], float4 out[49
  * w^3 p_uv = w A_uv - w_u B_v - w_v B_u, w^3 p_vv likewise, A_ab = w X_ab - w_ab X,
  * B_a = w X_a - w_a X, all (9, 9) Bernstein nets); M_ab = max |H_k.ab|, and Lemma 3's alpha for
  * rho = M_vv / M_uu (0 when M_uu or M_vv is 0).  About 8,000 float4 multiply-adds per rational
- * patch: stage 1 does not call this, kernels/stages/constants.cl does, once per scene. */
+ * patch: stage 1 calls it once per patch and scene and keeps the result (kinds/bezier.h). */
 inline float4 zs_constants(const float4 b[16])
 {
     float3 lo = b[0].xyz / b[0].w, hi = lo;
@@ -140,17 +154,19 @@ inline float4 zs_constants(const float4 b[16])
     cubic_derivative(h, 0, h_v);
 
     float4 b_u[49], b_v[49], a[49], hull[3][100];
-    float cube[100];
-    for (int k = 0; k < 49; ++k)
+    float weight[16], square[49], cube[100];
+    for (int k = 0; k < 16; ++k)
+        weight[k] = h[k].w;
+    for (int k = 0; k < 49; ++k) {
         b_u[k] = b_v[k] = a[k] = 0.0f;
-    for (int k = 0; k < 100; ++k)
-        hull[0][k] = 0.0f;
-    convolve_scaled(h, 3, h, 3, 1.0f, a);        /* w^2 in .w */
-    convolve_scaled(h, 3, a, 6, 1.0f, hull[0]);  /* w^3 in .w */
+        square[k] = 0.0f;
+    }
     for (int k = 0; k < 100; ++k) {
-        cube[k] = hull[0][k].w;
+        cube[k] = 0.0f;
         hull[0][k] = hull[1][k] = hull[2][k] = 0.0f;
     }
+    convolve_weights(weight, 3, weight, 3, square);  /* w^2 */
+    convolve_weights(weight, 3, square, 6, cube);    /* w^3 */
     convolve_wedge(h, h_u, b_u);
     convolve_wedge(h, h_v, b_v);
 
@@ -204,12 +220,6 @@ inline float2 zs_constant_steps(float4 bound, float eps)
             step = diagonal;
     }
     return 1.0f / step;
-}
-
-/* The steps' inverses for a patch and tolerance eps in one go (zs_inverse_steps on the host). */
-inline float2 zs_inverse_steps(const float4 b[16], float eps)
-{
-    return zs_constant_steps(zs_constants(b), eps);
 }
 
 #endif

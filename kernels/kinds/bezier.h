@@ -4,8 +4,8 @@
  * Layout: 16 float4 homogeneous control points b[4*j + i] = (w*x, w*y, w*z, w), i along u, j
  * along v.  Domain: the unit square (u, v); edges counter-clockwise 0: v=0, 1: u=1, 2: v=1,
  * 3: u=0 (quad_edge_point).  Stage 1 reads the patches (controls, as stage 4 does) and their
- * bound's constants (source: one float4 per patch, made once per scene by kind_constants in
- * kernels/stages/constants.cl; PatchKind.per_patch_constants). */
+ * bound's constants (source: one float4 per patch, made by stage 1 on first use and kept with
+ * the scene; PatchKind.per_patch_constants). */
 #ifndef CLTESS_KINDS_BEZIER_H
 #define CLTESS_KINDS_BEZIER_H
 #include "common.h"
@@ -140,18 +140,13 @@ inline void edge_controls(const float4 b[16], int e, float4 c[4])
 
 /* --- the kind contract (docs/extending.md) ----------------------------------------------------- */
 
-/* Once per scene: the constants of patch p's bound, which depend on the patch alone
- * (criteria/zs.h, zs_constants; stages/constants.cl). */
-inline float4 kind_constants(__global const float4 *controls, uint p)
-{
-    float4 b[16];
-    load_patch(controls, p, b);
-    return zs_constants(b);
-}
-
-/* Stage 1: factors (m, n, m, n) by edge from the Zheng-Sederberg bound with the patch's
- * constants source[p] (kind_constants); *flags as FLAG_*. */
-inline int4 kind_factors(__global const float4 *source, __global float4 *controls, uint p,
+/* Stage 1: factors (m, n, m, n) by edge from the Zheng-Sederberg bound; *flags as FLAG_*.
+ * source[p]: the constants of the patch's bound (criteria/zs.h zs_constants), which depend on the
+ * patch alone and are kept with the scene (PatchKind.per_patch_constants, Tessellator.upload):
+ * .x < 0 marks them not yet made, and the first call that sees the patch (not culled) makes and
+ * stores them, so later calls evaluate only zs_constant_steps.  Work-item p writes only
+ * source[p]. */
+inline int4 kind_factors(__global float4 *source, __global float4 *controls, uint p,
                          tolerance_args tol, int max_factor, int *flags)
 {
     float4 b[16];
@@ -168,7 +163,12 @@ inline int4 kind_factors(__global const float4 *source, __global float4 *control
         *flags = FLAG_CULLED;
         return (int4)(0);
     }
-    float2 inverse = zs_constant_steps(source[p], eps);  /* docs/rational-bound.md */
+    float4 constants = source[p];
+    if (constants.x < 0.0f) {  /* not made yet for this scene */
+        constants = zs_constants(b);
+        source[p] = constants;
+    }
+    float2 inverse = zs_constant_steps(constants, eps);  /* docs/rational-bound.md */
     int saturated = 0;
     int m = edge_factor(inverse.x, max_factor, &saturated);
     int n = edge_factor(inverse.y, max_factor, &saturated);

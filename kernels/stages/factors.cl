@@ -5,12 +5,14 @@
  * at 2^max_level), FLAG_CULLED, FLAG_FOLDED (common.h).  Built with -D PATTERN_DYADIC for a
  * dyadic pattern (semi-uniform): the factors are rounded up to 2^p_e here, before the crack-free
  * pass, for every kind alike (common.h dyadic_factors).  Built with -D PATTERN_ESC for the ESC
- * pattern (Bezier patches only): its candidate masks instead (criteria/esc_distance.h). */
+ * pattern (Bezier patches only): its candidate masks instead (criteria/esc_distance.h), from
+ * the patches in controls.  source is writable for a kind that keeps per-patch constants there
+ * (PatchKind.per_patch_constants: the Bezier kind's bound). */
 #ifdef PATTERN_ESC
 #include "criteria/esc_distance.h"  /* the pattern's own stage 1: candidate masks (patterns/esc.h) */
 #endif
 
-__kernel void factors(__global const float4 *source, __global float4 *controls, uint num_patches,
+__kernel void factors(__global float4 *source, __global float4 *controls, uint num_patches,
                       uint patch_base, float eps, float16 view, float4 frustum, float pixels,
                       float pixel_size, int max_factor, int max_level, __global int4 *factors,
                       __global int *flags)

@@ -31,7 +31,6 @@ STAGE_AXES = {
     "level_indices": ("pattern",),  # two kernels: level_interior, level_band
     "vertex_rows": ("kind", "pattern"),  # stage 4 a work-item per row (Tessellator(rows_in_parallel=True))
     "verify": ("kind",),  # on request only (Tessellator.verify), so not in STAGES
-    "constants": ("kind",),  # once per scene for kinds with per_patch_constants (Tessellator.upload)
     # silhouette refinement per frame (silhouette.py; they include criteria/silhouette.h)
     "silhouette_alpha": (),
     "silhouette_levels": (),
@@ -125,8 +124,6 @@ class Programs:
         """Build (or find) every stage's program for one (kind, pattern, tolerance) now."""
         for stage in STAGES:
             self.kernel(stage, kind=kind, pattern=pattern, tolerance=tolerance, crack=pattern.crack)
-        if kind.per_patch_constants:  # run once per scene, before stage 1
-            self.kernel("constants", kind=kind)
 
     def build(self, stage: str, headers: tuple, defines: dict) -> cl.Program:
         source, options = program_text(stage, headers, defines)

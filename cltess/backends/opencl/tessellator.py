@@ -147,7 +147,7 @@ class Tessellator:
         for kind in kinds:
             count = kind.count(scene)
             host = scene.prepared((kind.name, sharp_edges), lambda: kind.prepare(scene, sharp_edges))
-            parts.append((kind, base, count, self.upload(kind, host.source, scene, events)))
+            parts.append((kind, base, count, self.upload(kind, host.source, scene)))
             inputs.append(host)
             base += count
         objects = cl_array.to_device(self.queue, np.concatenate([host.objects for host in inputs]).astype(np.int32))
@@ -229,33 +229,25 @@ class Tessellator:
                 (("group_of", groups.group_of), ("group_start", groups.group_start), ("members", groups.members),
                  ("collapsed", collapsed))}
 
-    def upload(self, kind: PatchKind, source: np.ndarray, scene: Scene | None = None,
-               events: dict | None = None) -> dict:
+    def upload(self, kind: PatchKind, source: np.ndarray, scene: Scene | None = None) -> dict:
         """Device arrays of a kind: "source" (one row per patch) for stage 1, "controls" what
         stage 4 reads (written by stage 1, or the source itself).  A kind with
-        ``per_patch_constants`` has the source as controls and the constants as stage 1's source
-        (``patch_constants``: cached on ``scene`` for this context; its event in
-        ``events["constants"]`` when it ran)."""
+        ``per_patch_constants`` has the source as controls and its constants as stage 1's
+        source (``patch_constants``, kept on ``scene``)."""
         data = {"source": cl_array.to_device(self.queue, np.ascontiguousarray(source, np.float32))}
         shape = kind.controls_shape(len(source))
         data["controls"] = data["source"] if shape is None else cl_array.empty(self.queue, shape, np.float32)
         if kind.per_patch_constants:
-            data["source"] = self.patch_constants(kind, data["controls"], scene, events)
+            data["source"] = self.patch_constants(kind, len(source), scene)
         return data
 
-    def patch_constants(self, kind: PatchKind, controls, scene: Scene | None = None,
-                        events: dict | None = None) -> cl_array.Array:
-        """(P, 4) float32 on the device: kernels/stages/constants.cl on the kind's controls, the
-        part of its bound that depends on the patch alone.  With a scene, once per scene and
-        context (``Scene.prepared``: again only when the scene's arrays change)."""
+    def patch_constants(self, kind: PatchKind, count: int, scene: Scene | None = None) -> cl_array.Array:
+        """(count, 4) float32 on the device where stage 1 keeps the patches' bound constants
+        (PatchKind.per_patch_constants): made as "not yet" (-1), filled by stage 1 for each patch
+        it sees (not culled), kept with ``scene`` for this context (``Scene.prepared``: again
+        from scratch when the scene's arrays change), so every later call reads them."""
         def make():
-            count = len(controls)
-            out = cl_array.empty(self.queue, (count, 4), np.float32)
-            event = self.programs.kernel("constants", kind=kind)(
-                self.queue, _global_size(count), None, controls.data, np.uint32(count), out.data)
-            if events is not None:
-                events.setdefault("constants", []).append(event)
-            return self.context, out
+            return self.context, cl_array.to_device(self.queue, np.full((count, 4), -1.0, np.float32))
 
         if scene is None:
             return make()[1]
@@ -395,7 +387,7 @@ class Tessellator:
         count = len(patches)
         factors = cl_array.empty(self.queue, (count, FACTOR_SLOTS), np.int32)
         flags = cl_array.empty(self.queue, count, np.int32)
-        data = {"source": self.patch_constants(BEZIER, patches), "controls": patches}
+        data = {"source": self.patch_constants(BEZIER, len(patches)), "controls": patches}
         events = self.stage_factors_of(BEZIER, data, _tolerance(eps, pixels, camera), max_factor, factors, flags)
         return factors, flags, events
 
