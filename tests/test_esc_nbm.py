@@ -2,7 +2,6 @@
 section 1): NumPy mirror against the Bernstein evaluation in float64, and the device's
 NBM-Horner against direct evaluation and forward differencing in float32."""
 import numpy as np
-import pytest
 
 from cltess.surfaces.bezier import evaluate
 from cltess.surfaces.nbm import POWER_BASIS, evaluate_nbm, power_basis_matrix

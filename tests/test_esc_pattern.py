@@ -1,6 +1,5 @@
 """The ESC pattern (cltess/patterns/esc.py), exhaustively: every candidate mask of a coarse
 triangle for L <= 3 (512 at L = 3), and random masks of whole patches (docs/esc.md)."""
-import itertools
 
 import numpy as np
 import pytest

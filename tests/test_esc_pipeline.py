@@ -3,7 +3,6 @@ the NumPy mirror, watertightness, monotonicity in eps and the measured error (do
 from pathlib import Path
 
 import numpy as np
-import pytest
 
 from cltess.backends.numpy import NumpyBackend
 from cltess.bound import worst_bound_ratio

@@ -46,6 +46,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from ..strips import join_strips
 from .base import Pattern
 
 #: --max-level default for ESC (Table 1: "Lmax = 3 (16 x 18 triangles per surface)").
@@ -237,7 +238,6 @@ def patch_mesh(level: int, edge_masks, collapsed: int = 0):
 
     triangles = np.array([[remap(p) for p in t] for t in tris], np.int64).reshape(-1, 3)
     keep = (triangles[:, 0] != triangles[:, 1]) & (triangles[:, 1] != triangles[:, 2]) & (triangles[:, 0] != triangles[:, 2])
-    from ..strips import join_strips  # noqa: PLC0415 (patterns import before strips elsewhere)
     strip_indices = join_strips([[remap(p) for p in s] for s in strips])
     return np.array(order, np.int64).reshape(-1, 2), triangles[keep], strip_indices
 

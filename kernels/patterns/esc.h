@@ -214,7 +214,9 @@ typedef struct {
 inline uint esc_index(__private const esc_patch *g, int2 p)
 {
     int m = g->r.m;
-    for (int e = 0; e < 4; ++e) {  /* a collapsed edge's points, both corners included */
+    if (p.x > 0 && p.x < m && p.y > 0 && p.y < m)  /* inside: most points */
+        return (uint)(g->rows[p.y] + popcount(g->row_bits[p.y] & ((1u << p.x) - 1u)));
+    for (int e = 0; g->collapsed && e < 4; ++e) {  /* a collapsed edge's points, both corners included */
         int on = e == 0 ? p.y == 0 : e == 1 ? p.x == m : e == 2 ? p.y == m : p.x == 0;
         if (on && ((g->collapsed >> e) & 1))
             return (uint)g->ring[e];
