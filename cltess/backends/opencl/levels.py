@@ -60,8 +60,8 @@ def level_scan(context) -> GenericScanKernel:
     scan over virtual input, built once per context."""
     if context not in _LEVEL_SCANS:
         _LEVEL_SCANS[context] = GenericScanKernel(
-            context, np.uint32, preamble=LEVEL_PREAMBLE,
-            arguments="__global const int *factors, uint base, uint count, __global uint *queue, __global uint *ends",
+            context, np.uint64, preamble=LEVEL_PREAMBLE,  # ulong: see tests/oclgrind_scenarios.py BY_LEVEL
+            arguments="__global const int *factors, uint base, uint count, __global uint *queue, __global ulong *ends",
             input_expr="patch_level(factors, base + i % count) == (int)(i / count) ? 1 : 0",
             scan_expr="a+b", neutral="0",
             output_statement="if (prev_item != item) queue[prev_item] = base + i % count; "
@@ -120,7 +120,7 @@ def level_queues(tessellator: Tessellator, plan: Plan, first: int, last: int, ma
     ends are read back (M + 1 numbers)."""
     count = last - first
     patches = cl_array.empty(tessellator.queue, max(count, 1), np.uint32)
-    ends = cl_array.empty(tessellator.queue, max_level + 1, np.uint32)  # every entry written
+    ends = cl_array.empty(tessellator.queue, max_level + 1, np.uint64)  # every entry written
     event = level_scan(tessellator.context)(plan.factors, np.uint32(first), np.uint32(count), patches, ends,
                                             size=(max_level + 1) * count, queue=tessellator.queue)
     return LevelQueues(first, last, patches, [0] + ends.get().astype(int).tolist()), [event]
