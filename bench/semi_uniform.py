@@ -6,6 +6,7 @@ base -> uniform -> adaptive, and the speed of each method.
 
     python bench/semi_uniform.py [--device NAME] [--levels 3 5] [--sizes 200 1000 ...] [--views 3]
                                  [--pixels 0.5] [--repeat 5] [--max-uniform-triangles N] [--json OUT]
+    python bench/semi_uniform.py --emit-table OUT.json   # stages 4-5 alone, from a run's JSON
 
 The meshes are tori of about the base size with smooth radial bumps (so that the levels vary);
 each view is a 1024x768, 45 degree camera framing the mesh from a random direction (seeded by
@@ -156,7 +157,12 @@ def main(argv=None) -> int:
                         help="skip timing a uniform run above this many triangles per view (default 3e7)")
     parser.add_argument("--seed", type=int, default=11)
     parser.add_argument("--json", help="also write every measurement here")
+    parser.add_argument("--emit-table", metavar="JSON",
+                        help="print the stages 4-5 table of a --json file (no run) and exit")
     args = parser.parse_args(argv)
+    if args.emit_table:
+        print_emit_table(json.loads(Path(args.emit_table).read_text()))
+        return 0
 
     from cltess.pipeline import Tessellator
 
@@ -177,7 +183,7 @@ def main(argv=None) -> int:
                 row["methods"][name] = {
                     "triangles": sum(t.num_triangles for t in tesses), "device_ms": ms, "wall_ms": wall,
                     "saturated": sum(t.stats["saturated"] for t in tesses),
-                    "stage_ms": [t.stage_ms for t in tesses]}
+                    "stage_ms": [t.stage_ms for t in tesses]}  # of the last timed run
                 if name == "uniform":
                     assert all(t.num_triangles == row["uniform_triangles"] for t in tesses), "uniform != 4^M x base"
                 if name == "by level":
@@ -212,6 +218,28 @@ def print_row(row: dict, views: int, header: bool) -> None:
     print(f"{row['base']:>6} {row['M']:>2} {row['uniform_triangles']:>10} {snap['triangles'] // views:>9} "
           f"{snap['saturated'] / row['base'] / views:>4.0%}  {cells}  {row.get('level_queues', [[]])[0]}",
           flush=True)
+
+
+EMIT_STAGES = ("queues", "vertices", "indices")
+
+
+def print_emit_table(data: dict) -> None:
+    """Stages 4-5 alone (the queue scan, vertices, indices; device ms summed over the views, of
+    the last timed run) for the methods that share a plan: what by level changes."""
+    names = ("snap", "snap direct", "by level")
+    print(f"device: {data['device']}; stages 4-5 device ms summed over {data['views']} views (Mtri/s)")
+    print(f"{'base':>6} {'M':>2} " + "  ".join(f"{n:>17}" for n in names) + "  by level / snap direct")
+    for row in data["rows"]:
+        cells, ms = [], {}
+        for name in names:
+            method = row["methods"].get(name)
+            if method is None:
+                cells.append(f"{'-':>17}")
+                continue
+            ms[name] = sum(view.get(stage, 0.0) for view in method["stage_ms"] for stage in EMIT_STAGES)
+            cells.append(f"{ms[name]:>7.2f} ({method['triangles'] / ms[name] / 1e3:>7.1f})")
+        ratio = ms["by level"] / ms["snap direct"] if {"by level", "snap direct"} <= ms.keys() else float("nan")
+        print(f"{row['base']:>6} {row['M']:>2} " + "  ".join(cells) + f"  {ratio:>8.2f}")
 
 
 if __name__ == "__main__":
