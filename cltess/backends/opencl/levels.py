@@ -52,21 +52,23 @@ _LEVEL_SCANS: dict = {}
 _TEMPLATES: dict = {}
 
 
-def level_scan(context) -> GenericScanKernel:
+def level_scan(context, wide: bool = False) -> GenericScanKernel:
     """Stream compaction of the patches ``base .. base + count - 1`` by level, over the
     level-major sequence i = level * count + k (patch base + k at level i / count; N =
     (max_level + 1) * count): ``queue`` gets level 0's patches, then level 1's, each in patch
     order; ``ends[level]`` the number of patches of levels <= level.  pyopencl.algorithm.copy_if's
-    scan over virtual input, built once per context."""
-    if context not in _LEVEL_SCANS:
-        _LEVEL_SCANS[context] = GenericScanKernel(
-            context, np.uint64, preamble=LEVEL_PREAMBLE,  # ulong: see tests/oclgrind_scenarios.py BY_LEVEL
+    scan over virtual input, built once per context; ``wide``: 64-bit indices, for N >= 2^31.
+    Its items are ulong: with uint ones, Oclgrind's uninitialised-value pass reported the queues
+    of the whole by-level scenarios too (tests/oclgrind_scenarios.py, UNINITIALIZED_SKIPPED)."""
+    if (context, wide) not in _LEVEL_SCANS:
+        _LEVEL_SCANS[context, wide] = GenericScanKernel(
+            context, np.uint64, preamble=LEVEL_PREAMBLE, index_dtype=np.int64 if wide else np.int32,
             arguments="__global const int *factors, uint base, uint count, __global uint *queue, __global ulong *ends",
             input_expr="patch_level(factors, base + i % count) == (int)(i / count) ? 1 : 0",
             scan_expr="a+b", neutral="0",
             output_statement="if (prev_item != item) queue[prev_item] = base + i % count; "
                              "if ((i + 1) % count == 0) ends[i / count] = item;")
-    return _LEVEL_SCANS[context]
+    return _LEVEL_SCANS[context, wide]
 
 
 def level_templates(tessellator: Tessellator, domain: str, level: int) -> tuple[cl_array.Array, cl_array.Array]:
@@ -121,8 +123,9 @@ def level_queues(tessellator: Tessellator, plan: Plan, first: int, last: int, ma
     count = last - first
     patches = cl_array.empty(tessellator.queue, max(count, 1), np.uint32)
     ends = cl_array.empty(tessellator.queue, max_level + 1, np.uint64)  # every entry written
-    event = level_scan(tessellator.context)(plan.factors, np.uint32(first), np.uint32(count), patches, ends,
-                                            size=(max_level + 1) * count, queue=tessellator.queue)
+    size = (max_level + 1) * count
+    event = level_scan(tessellator.context, size >= 2**31)(
+        plan.factors, np.uint32(first), np.uint32(count), patches, ends, size=size, queue=tessellator.queue)
     return LevelQueues(first, last, patches, [0] + ends.get().astype(int).tolist()), [event]
 
 
