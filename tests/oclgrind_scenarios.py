@@ -349,9 +349,23 @@ VERIFIED = ("rational_sphere", "pn_icosphere", "mixed_culled")
 #: output cap in bytes, so stages 4-5 run on sub-ranges of the patches.
 BATCHED = {"many_patches_batched": ("many_patches", 4096)}
 
-#: Scenarios whose stage 4 runs by level (cltess/backends/opencl/levels.py emit_by_level).
+#: Scenarios whose stages 4-5 run by level (Request.emit "by_level", cltess/backends/opencl/levels.py),
+#: whole or (base, output cap in bytes) in batches (the queues and outputs of patch sub-ranges).
 BY_LEVEL = {"semi_uniform_by_level": "semi_uniform",
-            "pn_semi_uniform_mixed_culled_by_level": "pn_semi_uniform_mixed_culled"}
+            "pn_semi_uniform_mixed_culled_by_level": "pn_semi_uniform_mixed_culled",
+            "pn_semi_uniform_mixed_culled_by_level_batched": ("pn_semi_uniform_mixed_culled", 8192)}
+
+#: Scenarios left out of the uninitialised-value pass (they still run the checks pass), and why.
+UNINITIALIZED_SKIPPED = {
+    "pn_semi_uniform_mixed_culled_by_level_batched":
+        "pyopencl's scan, at some sizes (here the level scans of the 28- and 27-patch batches, "
+        "N = 112 and 108), carries the shadow of the local memory its last unit reads past the end "
+        "(the scan_lev1/2 reports allowed below) into its in-range outputs (scan_final_update "
+        "reports), so every kernel that reads the queues is reported. Seen the same way for the "
+        "offsets scan of a 324-patch scene in the per-patch path; the values are right (the "
+        "outputs equal the per-patch path's, tests/test_semi_uniform_levels.py, and the checks pass "
+        "is clean).",
+}
 
 #: Scenarios whose stage 4 runs a work-item per (patch, row) (stages/vertex_rows.cl), with 3
 #: work-items per patch so that the last one does the remaining rows too.
@@ -429,12 +443,14 @@ def run_scenario(name: str, tessellator, out_dir: Path) -> dict:
     from cltess.io.npz import write_npz
     from cltess.tessellation import Tessellation
 
-    if name in BATCHED:
-        base, cap = BATCHED[name]
+    if name in BATCHED or isinstance(BY_LEVEL.get(name), tuple):
+        base, cap = BATCHED.get(name) or BY_LEVEL[name]
         scene, options = SCENARIOS[base]()
         if not hasattr(tessellator, "tessellate_in_batches"):
             return {"name": name, "skipped": "the pipeline has no tessellate_in_batches"}
         fd = options.pop("forward_differencing", True)
+        if name in BY_LEVEL:
+            options["emit"] = "by_level"
         _, batches = tessellator.tessellate_in_batches(scene, cap, forward_differencing=fd, **options)
         parts = list(batches)
         tess = Tessellation(**{k: np.concatenate([getattr(b, k) for b in parts])
@@ -449,11 +465,10 @@ def run_scenario(name: str, tessellator, out_dir: Path) -> dict:
         options = {"sharp_edges": scenario_options.get("sharp_edges", "straight"), **options}
         tess = SilhouetteRefiner(tessellator, scene, **options).frame(np.array(eye)).tessellation
     elif name in BY_LEVEL:
-        from cltess.backends.opencl.levels import emit_by_level, plan_by_level
         from cltess.request import Request
 
         scene, options = SCENARIOS[BY_LEVEL[name]]()
-        tess = emit_by_level(tessellator, plan_by_level(tessellator, scene, Request.of(**options)))
+        tess = tessellator.tessellate(scene, Request.of(**options, emit="by_level"))
     elif name in ROWS_IN_PARALLEL:
         from cltess.backends.opencl import tessellator as opencl
 

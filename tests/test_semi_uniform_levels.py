@@ -82,7 +82,8 @@ def test_queues_partition_the_patches_by_level(tessellator, rng):
     teapot = load_scene(SCENES / "teapot.bez")
     scene, options = mixed_culled()
     for scene, request in ((teapot, Request.of(eps=3e-3, pattern="semi_uniform")),
-                           (scene, Request.of(**options, pattern="semi_uniform", max_level=4))):
+                           (scene, Request.of(**options, pattern="semi_uniform", max_level=4)),
+                           (teapot, Request.of(eps=3e-3, pattern="semi_uniform", max_level=14))):
         plan = tessellator.plan(scene, request)
         levels = np.log2(np.maximum(np.abs(plan.host_factors()).max(axis=1), 1)).astype(int)
         levels[np.abs(plan.host_factors())[:, 0] == 0] = -1  # culled

@@ -29,17 +29,17 @@ __kernel void level_vertices(__global const float4 *controls, __global const int
     kind_patch patch;
     kind_load(controls, p - patch_base, &patch);
     ulong at = vertex_offsets[p] - vertex_base + (ulong)point.vertex;
+    /* One kind_eval for ring and interior points alike (the work-items of a vector run both
+     * sides of a branch): the normal, and the position of an interior point; a ring point's
+     * position is then the edge's (kind_boundary_point), as stages/vertices.cl computes them. */
+    int on_ring = point.edge >= 0, e = max(point.edge, 0);
+    edge_param t = pattern_ring_param(f, e, point.k);
+    float3 x = on_ring ? pattern_edge_point(e, t) : pattern_row_point(f, ij.y, ij.x);
     float3 position, normal;
-    if (point.edge >= 0) {
-        edge_param t = pattern_ring_param(f, point.edge, point.k);
-        float3 x = pattern_edge_point(point.edge, t);
-        kind_eval(&patch, x, 0, &normal);  /* the normal; the position is the edge's */
+    kind_eval(&patch, x, &position, &normal);
+    if (on_ring) {
         edge_param corner = {0, t.f};  /* a collapsed edge: every point is its first corner */
-        put_vertex(out, at, kind_boundary_point(&patch, point.edge, (collapsed >> point.edge) & 1 ? corner : t),
-                   normal, x.xy, p, patch_objects[p]);
-    } else {
-        float3 x = pattern_row_point(f, ij.y, ij.x);
-        kind_eval(&patch, x, &position, &normal);
-        put_vertex(out, at, position, normal, x.xy, p, patch_objects[p]);
+        position = kind_boundary_point(&patch, e, (collapsed >> e) & 1 ? corner : t);
     }
+    put_vertex(out, at, position, normal, x.xy, p, patch_objects[p]);
 }
