@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pyopencl as cl
+from pyopencl import cltypes
 from pyopencl.scan import GenericScanKernel
 
 from ...device import BuildError, first_error_line
@@ -85,15 +86,14 @@ class Programs:
             context, np.uint64, arguments="__global const ulong *counts, __global ulong *offsets",
             input_expr="counts[i]", scan_expr="a+b", neutral="0",
             output_statement="offsets[i + 1] = item;")
-        # Stage 3's two scans as one launch sequence: vertex counts then index counts, one
-        # segment each (issue 15: the offsets stage was mostly the launches of two scans).
+        # Stage 3's two scans as one: (vertex count, index count) pairs scanned as ulong2
+        # (issue 15: the offsets stage was mostly the launches of two scans).
         self.offsets_scan_pair = GenericScanKernel(
-            context, np.uint64,
+            context, cltypes.ulong2,
             arguments="__global const ulong *vertex_counts, __global const ulong *index_counts, "
-                      "__global ulong *vertex_offsets, __global ulong *index_offsets, const ulong count",
-            input_expr="i < count ? vertex_counts[i] : index_counts[i - count]",
-            is_segment_start_expr="i == count", scan_expr="across_seg_boundary ? b : a + b", neutral="0",
-            output_statement="if (i < count) vertex_offsets[i + 1] = item; else index_offsets[i - count + 1] = item;")
+                      "__global ulong *vertex_offsets, __global ulong *index_offsets",
+            input_expr="(ulong2)(vertex_counts[i], index_counts[i])", scan_expr="a + b", neutral="(ulong2)(0, 0)",
+            output_statement="vertex_offsets[i + 1] = item.x; index_offsets[i + 1] = item.y;")
 
     def kernel(self, stage: str, **axes) -> cl.Kernel:
         """The stage's kernel composed for ``axes`` (kind=, pattern=, tolerance=, crack=)."""

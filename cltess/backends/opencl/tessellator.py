@@ -411,8 +411,7 @@ class Tessellator:
             self.queue, _global_size(n), None, factors.data, np.uint32(n), np.uint32(base),
             vertex_counts.data, index_counts.data) for k, base, n in ranges if n]
         if count:
-            events.append(self.programs.offsets_scan_pair(vertex_counts, index_counts, vertex_offsets, index_offsets,
-                                                          np.uint64(count), size=2 * count))
+            events.append(self.programs.offsets_scan_pair(vertex_counts, index_counts, vertex_offsets, index_offsets))
         return vertex_offsets, index_offsets, events
 
     def _vertex_arrays(self, n: int) -> dict:
