@@ -14,7 +14,6 @@ from pathlib import Path
 
 import numpy as np
 import pyopencl as cl
-from pyopencl import cltypes
 from pyopencl.scan import GenericScanKernel
 
 from ...device import BuildError, first_error_line
@@ -86,14 +85,6 @@ class Programs:
             context, np.uint64, arguments="__global const ulong *counts, __global ulong *offsets",
             input_expr="counts[i]", scan_expr="a+b", neutral="0",
             output_statement="offsets[i + 1] = item;")
-        # Stage 3's two scans as one: (vertex count, index count) pairs scanned as ulong2
-        # (issue 15: the offsets stage was mostly the launches of two scans).
-        self.offsets_scan_pair = GenericScanKernel(
-            context, cltypes.ulong2,
-            arguments="__global const ulong *vertex_counts, __global const ulong *index_counts, "
-                      "__global ulong *vertex_offsets, __global ulong *index_offsets",
-            input_expr="(ulong2)(vertex_counts[i], index_counts[i])", scan_expr="a + b", neutral="(ulong2)(0, 0)",
-            output_statement="vertex_offsets[i + 1] = item.x; index_offsets[i + 1] = item.y;")
 
     def kernel(self, stage: str, **axes) -> cl.Kernel:
         """The stage's kernel composed for ``axes`` (kind=, pattern=, tolerance=, crack=)."""

@@ -410,8 +410,10 @@ class Tessellator:
         events = [self.programs.kernel("counts", pattern=_pattern(k))(
             self.queue, _global_size(n), None, factors.data, np.uint32(n), np.uint32(base),
             vertex_counts.data, index_counts.data) for k, base, n in ranges if n]
-        if count:
-            events.append(self.programs.offsets_scan_pair(vertex_counts, index_counts, vertex_offsets, index_offsets))
+        # Two scans: one scan of (vertex, index) pairs as ulong2 was misaligned in pyopencl's local
+        # memory, and a segmented one read uninitialised flags (both Oclgrind, issue 15).
+        events += [self.programs.offsets_scan(vertex_counts, vertex_offsets),
+                   self.programs.offsets_scan(index_counts, index_offsets)]
         return vertex_offsets, index_offsets, events
 
     def _vertex_arrays(self, n: int) -> dict:
