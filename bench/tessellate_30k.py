@@ -85,6 +85,9 @@ def main() -> int:
     parser.add_argument("--eps", type=float, default=0.0085)
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--folder", help="where the scene and the PLY go (default: a temporary folder here)")
+    parser.add_argument("--baseline", metavar="SOURCE_TREE",
+                        help="also run the CLI of another checkout (PYTHONPATH=SOURCE_TREE), its runs "
+                             "interleaved with these, e.g. the main branch before issue 15")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory(dir=args.folder or ".") as folder:
         folder = Path(folder)
@@ -96,14 +99,19 @@ def main() -> int:
         rows = {}
         for orient in ("--orient", "--no-orient"):
             for state in ("cold", "warm"):
-                walls = []
+                walls, baseline = [], []
                 for _ in range(args.repeat):
                     cache = folder / f"cache-{orient}-{len(walls)}"  # cold: a fresh cache each run
                     env = dict(os.environ, CLTESS_SCENE_CACHE=str(cache if state == "cold" else folder / "cache"))
                     if state == "warm" and not walls:
                         run_cli([str(scene), orient, *base], env)  # fills the warm cache
                     walls.append(run_cli([str(scene), orient, *base], env))
+                    if args.baseline and state == "cold":  # the baseline has no cache: cold only
+                        baseline.append(run_cli([str(scene), orient, *base],
+                                                dict(env, PYTHONPATH=str(Path(args.baseline).resolve()))))
                 rows[(orient, state)] = walls
+                if baseline:
+                    rows[(orient, "baseline")] = baseline
         size = out.stat().st_size
         print(f"PLY {size / 1e6:.0f} MB, eps {args.eps}; wall seconds, median [min-max] of {args.repeat}:")
         for (orient, state), walls in rows.items():
