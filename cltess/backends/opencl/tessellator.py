@@ -14,7 +14,8 @@ pass, one scan, one Plan and its batches cover them all.  A kind's kernels take
 patch ids are indexed by scene number.
 
 Everything between stage 1 and stage 5 stays on the device; the host reads back the two totals
-to size the output buffers, then the outputs.
+to size the output buffers, then the outputs, or leaves them there (``emit(..., on_device=True)``
+and every ``cltess.Session`` frame: ``OutputBuffers``, ``DeviceOutput``).
 """
 from __future__ import annotations
 
