@@ -99,15 +99,6 @@ class Programs:
             context, np.uint64, arguments="__global const ulong *counts, __global ulong *offsets",
             input_expr="counts[i]", scan_expr="a+b", neutral="0",
             output_statement="offsets[i + 1] = item;")
-        # Stage 3's two scans as one launch sequence: vertex counts then index counts, one
-        # segment each (issue 15: the offsets stage was mostly the launches of two scans).
-        self.offsets_scan_pair = GenericScanKernel(
-            context, np.uint64,
-            arguments="__global const ulong *vertex_counts, __global const ulong *index_counts, "
-                      "__global ulong *vertex_offsets, __global ulong *index_offsets, const ulong count",
-            input_expr="i < count ? vertex_counts[i] : index_counts[i - count]",
-            is_segment_start_expr="i == count", scan_expr="across_seg_boundary ? b : a + b", neutral="0",
-            output_statement="if (i < count) vertex_offsets[i + 1] = item; else index_offsets[i - count + 1] = item;")
 
     def kernel(self, stage: str, entry: str | None = None, **axes) -> cl.Kernel:
         """The stage's kernel composed for ``axes`` (kind=, pattern=, tolerance=, crack=): the

@@ -14,7 +14,8 @@ pass, one scan, one Plan and its batches cover them all.  A kind's kernels take
 patch ids are indexed by scene number.
 
 Everything between stage 1 and stage 5 stays on the device; the host reads back the two totals
-to size the output buffers, then the outputs.
+to size the output buffers, then the outputs, or leaves them there (``emit(..., on_device=True)``
+and every ``cltess.Session`` frame: ``OutputBuffers``, ``DeviceOutput``).
 """
 from __future__ import annotations
 
@@ -449,9 +450,10 @@ class Tessellator:
         events = [self.programs.kernel("counts", pattern=_pattern(k))(
             self.queue, _global_size(n), None, factors.data, np.uint32(n), np.uint32(base),
             vertex_counts.data, index_counts.data) for k, base, n in ranges if n]
-        if count:
-            events.append(self.programs.offsets_scan(vertex_counts, vertex_offsets, size=count))
-            events.append(self.programs.offsets_scan(index_counts, index_offsets, size=count))
+        # Two scans: one scan of (vertex, index) pairs as ulong2 was misaligned in pyopencl's local
+        # memory, and a segmented one read uninitialised flags (both Oclgrind, issue 15).
+        events += [self.programs.offsets_scan(vertex_counts, vertex_offsets),
+                   self.programs.offsets_scan(index_counts, index_offsets)]
         return vertex_offsets, index_offsets, events
 
     def _vertex_arrays(self, n: int) -> dict:
