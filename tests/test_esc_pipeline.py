@@ -129,3 +129,60 @@ def test_collapsed_edges_leave_no_triangle_on_them(tessellator):
     mesh = weld_exact(device.positions, device.triangles)
     assert len(mesh.faces) == len(device.triangles)  # no triangle collapsed onto a pole
     assert mesh.is_winding_consistent
+
+
+def candidate_distances(patch, level):
+    """(33, L) float64 |V_B - V_S| of every candidate (canonical directions), as masks.py tests them."""
+    from cltess.esc.masks import curve_points, edge_reversed
+    from cltess.scene import boundary_curves
+    from cltess.surfaces.bezier import evaluate
+    n, m = level + 1, 3 * (level + 1)
+    out = np.zeros((33, level))
+    k = np.arange(n + 1)
+    for c, (start, end) in enumerate(esc.COARSE_EDGES):
+        points = evaluate(patch, (n * start[0] + k * (end[0] - start[0])) / m,
+                          (n * start[1] + k * (end[1] - start[1])) / m)[0]
+        chord = points[0] * (n - k[1:-1, None]) / n + points[-1] * k[1:-1, None] / n
+        out[c] = np.linalg.norm(points[1:-1] - chord, axis=1)
+    for e in range(4):  # boundary edges from the curve, in its canonical direction
+        controls = boundary_curves(patch[None])[0, e]
+        if edge_reversed(controls.astype(np.float32)):
+            controls = controls[::-1]
+        points = curve_points(controls, np.arange(m + 1) / m)
+        ccw = []
+        for s in range(3):
+            seg = points[s * n:s * n + n + 1]
+            chord = seg[0] * (n - k[1:-1, None]) / n + seg[-1] * k[1:-1, None] / n
+            ccw.append(np.linalg.norm(seg[1:-1] - chord, axis=1))
+        # canonical segment s is the patch edge's segment s, or 2 - s reversed
+        flip = edge_reversed(boundary_curves(patch[None])[0, e].astype(np.float32))
+        for s, c in enumerate(esc.PATCH_EDGE_COARSE[e]):
+            d = ccw[2 - s][::-1] if flip else ccw[s]  # counter-clockwise order along the edge
+            out[c] = d[::-1] if esc.PATCH_EDGE_AGAINST[e] else d
+    return out
+
+
+def test_stage_1_on_random_patches_equals_the_mirror_but_at_the_threshold(tessellator, rng):
+    """Device stage 1 (float32, NBM inside) against the float64 mirror on random rational patches:
+    every record equal, except candidate bits whose distance is within 1e-4 of the patch size of
+    eps (where float32 may round either way)."""
+    from cltess.scene import Scene
+    from support import random_patches
+    patches = random_patches(rng, 300, spread=1.0).astype(np.float32).astype(np.float64)
+    scene = Scene(patches, np.zeros(len(patches), np.int32), name="random")
+    for eps in (3e-3, 3e-2):
+        request = Request.of(eps=eps, pattern="esc")
+        device = tessellator.plan(scene, request).factors.get()
+        host = NumpyBackend().plan(scene, request).factors
+        differ = np.flatnonzero((device != host).any(axis=1))
+        assert len(differ) < 0.05 * len(patches)
+        for p in range(10):  # the distances below are the ones the mirror tested
+            bits = ((candidate_distances(patches[p], 3) > eps) * (1 << np.arange(3))).sum(axis=1)
+            assert np.array_equal(bits, esc.unpack(np.abs(host[p]))[1])
+        for p in differ:
+            _, got = esc.unpack(np.abs(device[p]))
+            _, expected = esc.unpack(np.abs(host[p]))
+            distances = candidate_distances(patches[p], 3)
+            size = np.abs(patches[p, ..., :3] / patches[p, ..., 3:]).max()
+            for c, k in zip(*np.nonzero(((got ^ expected)[:, None] >> np.arange(3)) & 1)):
+                assert abs(distances[c, k] - eps) < 1e-4 * size, (p, c, k, distances[c, k], eps)

@@ -36,10 +36,13 @@ __kernel void vertices(__global const float4 *controls, __global const int4 *fac
         }
     }
 
+#if !PATTERN_UNIFORM_ROWS
+    forward_differencing = 0;  /* the rows' points are not equally spaced (patterns/layout.h) */
+#endif
     int rows = pattern_rows(f);
     for (int j = 1; j <= rows; ++j) {
         int steps = pattern_row(f, j);
-        if (forward_differencing && PATTERN_UNIFORM_ROWS) {
+        if (forward_differencing) {
             kind_row row;
             kind_row_begin(&patch, pattern_row_point(f, j, 0), pattern_row_point(f, j, steps), steps, &row);
             for (int i = 1; i < steps; ++i) {
