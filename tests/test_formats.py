@@ -343,8 +343,8 @@ def test_json_transform_ids_and_camera(tmp_path):
 
 def test_json_parses_each_file_once(tmp_path, monkeypatch):
     calls = []
-    original = bez.parse
-    monkeypatch.setattr(bez, "parse", lambda lines: calls.append(lines.name) or original(lines))
+    original = bez.read_patches
+    monkeypatch.setattr(bez, "read_patches", lambda path: calls.append(str(path)) or original(path))
     doc = {"objects": [{"file": "teapot.bez"}, {"file": "./teapot.bez"}, {"file": "../" + tmp_path.name + "/teapot.bez"}]}
     scene = load_scene(write_json(tmp_path, doc))
     assert scene.num_patches == 96 and len(calls) == 1

@@ -17,16 +17,23 @@ _INDEX_LINE_BYTES = _byte_set(b"0123456789, \t\n")
 
 def read_bez(path) -> Scene:
     """An indexed ``.bez`` file as a single-object scene (object id 0)."""
+    patches = read_patches(path)
+    return Scene(patches, np.zeros(len(patches), np.int32), None, str(path))
+
+
+def read_patches(path) -> np.ndarray:
+    """The file's (P, 4, 4, 4) homogeneous patches: parsed by NumPy at once (_fast_bez), or line
+    by line where that finds something to report (_parse_bez, naming the line); a large file's
+    from the binary cache when its bytes were parsed before (io/scene_cache.py)."""
     data = _read_bytes(path)
 
     def parse(data):
         patches = _fast_bez(data)
-        if patches is None:  # something to report, or unusual: line by line, naming the line
+        if patches is None:
             patches = _parse_bez(_Lines(str(path), _decode(path, data)))
         return patches
 
-    patches = cached_patches(data, "bez", parse)
-    return Scene(patches, np.zeros(len(patches), np.int32), None, str(path))
+    return cached_patches(data, "bez", parse)
 
 
 def _fast_bez(data: bytes) -> np.ndarray | None:

@@ -17,16 +17,23 @@ _BPT_LINES_PER_PATCH = 17  # "3 3" + 16 points
 
 def read_bpt(path) -> Scene:
     """A ``.bpt`` file as a single-object scene (object id 0)."""
+    patches = read_patches(path)
+    return Scene(patches, np.zeros(len(patches), np.int32), None, str(path))
+
+
+def read_patches(path) -> np.ndarray:
+    """The file's (P, 4, 4, 4) homogeneous patches: parsed by NumPy at once (_fast_bpt), or line
+    by line where that finds something to report (_parse_bpt, naming the line); a large file's
+    from the binary cache when its bytes were parsed before (io/scene_cache.py)."""
     data = _read_bytes(path)
 
     def parse(data):
         patches = _fast_bpt(data)
-        if patches is None:  # something to report, or unusual: line by line, naming the line
+        if patches is None:
             patches = _parse_bpt(_Lines(str(path), _decode(path, data)))
         return patches
 
-    patches = cached_patches(data, "bpt", parse)
-    return Scene(patches, np.zeros(len(patches), np.int32), None, str(path))
+    return cached_patches(data, "bpt", parse)
 
 
 def _fast_bpt(data: bytes) -> np.ndarray | None:

@@ -16,7 +16,7 @@ from ..scene import DEFAULT_CREASE_ANGLE, Camera, Scene, SceneError
 from . import bez, bpt
 from .meshes import MESH_EXTENSIONS, read_mesh
 from .text import INT32_MAX as _INT32_MAX  # noqa: N811
-from .text import _Lines, _read_text
+from .text import _read_text
 
 PATCH_FORMATS = {module.EXTENSION: module for module in (bpt, bez)}  # object files with patches
 
@@ -66,8 +66,7 @@ def read_json_scene(path, crease_angle: float | None = DEFAULT_CREASE_ANGLE) -> 
                 if ext in MESH_EXTENSIONS:
                     cache[resolved] = read_mesh(file_path, crease_angle=crease_angle)
                 else:
-                    lines = _Lines.read(file_path)
-                    cache[resolved] = PATCH_FORMATS[ext].parse(lines)
+                    cache[resolved] = PATCH_FORMATS[ext].read_patches(file_path)
         except SceneError as exc:
             raise where.error(f"{key}.file", str(exc)) from None
         except (OSError, RuntimeError, ValueError) as exc:  # a symlink loop, a NUL in the name

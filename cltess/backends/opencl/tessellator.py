@@ -19,6 +19,7 @@ and every ``cltess.Session`` frame: ``OutputBuffers``, ``DeviceOutput``).
 """
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 
@@ -646,10 +647,13 @@ class OutputBuffers:
         self._staging: dict = {}  # name -> (pinned buffer, its mapped host array)
         self._maps: list = []
 
-    @staticmethod
-    def _layout():
-        return [(name, np.dtype(dtype), shape) for name, dtype, shape in VERTEX_RECORD] + \
-            [("triangles", np.dtype(np.uint32), (3,))]
+    #: (name, dtype, per-row shape) of every output buffer: the vertex record, then triangles.
+    LAYOUT = tuple((name, np.dtype(dtype), shape) for name, dtype, shape in VERTEX_RECORD) + \
+        (("triangles", np.dtype(np.uint32), (3,)),)
+
+    @classmethod
+    def _layout(cls):
+        return cls.LAYOUT
 
     def take(self, num_vertices: int, num_triangles: int) -> dict:
         """pyopencl arrays of (num_vertices, ...) per vertex field and (num_triangles, 3)
@@ -660,7 +664,7 @@ class OutputBuffers:
         layout = self._layout()
         for name, dtype, shape in layout:
             rows = num_triangles if name == "triangles" else num_vertices
-            row_bytes = dtype.itemsize * int(np.prod(shape))
+            row_bytes = dtype.itemsize * math.prod(shape)
             buffer, capacity = self._buffers.get(name, (None, -1))
             if rows > capacity:  # the first allocation as asked; growing, a quarter more
                 capacity = rows if buffer is None else int(rows * self.GROWTH)
@@ -705,7 +709,7 @@ class OutputBuffers:
         """The page-locked host array of a field (allocated and mapped once per capacity)."""
         if name not in self._staging:
             buffer = cl.Buffer(self.context, cl.mem_flags.READ_WRITE | cl.mem_flags.ALLOC_HOST_PTR,
-                               max(capacity, 1) * dtype.itemsize * int(np.prod(shape)))
+                               max(capacity, 1) * dtype.itemsize * math.prod(shape))
             array, _ = cl.enqueue_map_buffer(self.queue, buffer, cl.map_flags.READ | cl.map_flags.WRITE, 0,
                                              (max(capacity, 1), *shape), dtype, is_blocking=True)
             self._staging[name] = (buffer, array)
