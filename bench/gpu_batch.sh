@@ -10,12 +10,7 @@
 set -u
 out=${1:?usage: bash bench/gpu_batch.sh OUTDIR [options]}
 shift
-python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade --target /tmp/site .whl/*.whl || exit 1
-export PYTHONPATH=/tmp/site:$PWD PYTHONUNBUFFERED=1
-python3 -c "import cltess.kernels" 2>/dev/null || ln -s ../kernels cltess/kernels
-mkdir -p /tmp/icd
-echo /usr/local/nvidia/lib64/libnvidia-opencl.so.1 > /tmp/icd/nvidia.icd
-export OCL_ICD_VENDORS=/tmp/icd
+. bench/gpu_setup.sh
 {
   echo "## nvidia-smi"; nvidia-smi -L
   echo "## lscpu"; lscpu | head -20

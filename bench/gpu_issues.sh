@@ -12,12 +12,7 @@
 set -u
 out=${1:?usage: bash bench/gpu_issues.sh OUTDIR speed|patterns}
 which=${2:?usage: bash bench/gpu_issues.sh OUTDIR speed|patterns}
-python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade --target /tmp/site .whl/*.whl || exit 1
-export PYTHONPATH=/tmp/site:$PWD PYTHONUNBUFFERED=1
-python3 -c "import cltess.kernels" 2>/dev/null || ln -s ../kernels cltess/kernels
-mkdir -p /tmp/icd
-echo /usr/local/nvidia/lib64/libnvidia-opencl.so.1 > /tmp/icd/nvidia.icd
-export OCL_ICD_VENDORS=/tmp/icd
+. bench/gpu_setup.sh
 { nvidia-smi -L; python3 -m cltess devices; } > "$out/machine-$which.txt" 2>&1
 run() {  # run NAME SECONDS COMMAND...
   local name=$1 limit=$2; shift 2

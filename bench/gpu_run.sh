@@ -9,14 +9,8 @@
 # OpenCL devices), h100.{md,json}, pocl16.{md,json}, teapots.txt and log.txt into OUTDIR.
 set -u
 out=${1:?usage: bash bench/gpu_run.sh OUTDIR}
-python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade --target /tmp/site .whl/*.whl || exit 1
-export PYTHONPATH=/tmp/site:$PWD PYTHONUNBUFFERED=1 CLTESS_DATA=$PWD/.whl/data
-# cltess.kernels is the top-level kernels/ folder (an install maps it); without installing, link it
-python3 -c "import cltess.kernels" 2>/dev/null || ln -s ../kernels cltess/kernels
-mkdir -p /tmp/icd
-echo /usr/local/nvidia/lib64/libnvidia-opencl.so.1 > /tmp/icd/nvidia.icd
-cp /etc/OpenCL/vendors/pocl.icd /tmp/icd/ 2>>"$out/log.txt"
-export OCL_ICD_VENDORS=/tmp/icd
+GPU_SETUP_POCL=1 . bench/gpu_setup.sh
+export CLTESS_DATA=$PWD/.whl/data
 {
   echo "## nvidia-smi"; nvidia-smi
   echo "## lscpu"; lscpu

@@ -39,7 +39,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 import time
 from dataclasses import replace
@@ -50,6 +49,7 @@ import numpy as np
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 
+from cltess.bench import scenes as scenes_module  # noqa: E402
 from cltess.bench.scenes import framing_camera, random_rotation  # noqa: E402
 from cltess.request import Request  # noqa: E402
 from cltess.scene import Scene  # noqa: E402
@@ -59,26 +59,9 @@ METHODS = ("uniform", "no snap", "snap", "snap direct", "by level", "transition"
 
 
 def bumpy_torus(faces: int, seed: int, views: int) -> list[Scene]:
-    """A torus of about ``faces`` triangles (major sections twice the minor), its tube radius
-    modulated by smooth bumps, with vertex normals; one Scene per seeded random viewpoint."""
-    import trimesh
-
-    from cltess.bench.scenes import vertex_normals
-
-    minor = max(3, round(math.sqrt(faces / 4)))
-    mesh = trimesh.creation.torus(major_radius=2.0, minor_radius=0.7, major_sections=2 * minor,
-                                  minor_sections=minor)
-    rng = np.random.default_rng(seed)
-    vertices = np.array(mesh.vertices)
-    ring = vertices * [1, 1, 0]
-    ring = 2.0 * ring / np.linalg.norm(ring, axis=1, keepdims=True)
-    tube = vertices - ring
-    angle, height = np.arctan2(vertices[:, 1], vertices[:, 0]), np.arctan2(vertices[:, 2], np.linalg.norm(
-        vertices[:, :2], axis=1) - 2.0)
-    bumps = 1 + 0.25 * np.sin(3 * angle + rng.uniform(0, 6)) * np.cos(2 * height + rng.uniform(0, 6))
-    vertices = ring + tube * bumps[:, None]
-    faces_ = np.asarray(mesh.faces)
-    mesh = trimesh.Trimesh(vertices, faces_, vertex_normals=vertex_normals(vertices, faces_), process=False)
+    """cltess.bench.scenes.bumpy_torus, one Scene per seeded random viewpoint."""
+    mesh = scenes_module.bumpy_torus(faces, seed)
+    faces_ = mesh.faces
     scenes = []
     for view in range(views):
         direction = random_rotation(np.random.default_rng([seed, view]))[:, 0]

@@ -30,7 +30,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 import time
 from pathlib import Path
@@ -41,7 +40,8 @@ REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 
 from cltess.backends.opencl.silhouette import SilhouetteRefiner  # noqa: E402
-from cltess.bench.scenes import framing_camera, random_rotation, vertex_normals  # noqa: E402
+from cltess.bench import scenes  # noqa: E402
+from cltess.bench.scenes import framing_camera, random_rotation  # noqa: E402
 from cltess.criteria.silhouette import silhouetteness  # noqa: E402
 from cltess.scene import Scene  # noqa: E402
 
@@ -49,25 +49,9 @@ PAPER_SIZES = (200, 1000, 5000, 20000, 100000)  # Fig. 9's range: 200 .. 100k tr
 
 
 def bumpy_torus(faces: int, seed: int) -> Scene:
-    """A torus of about ``faces`` triangles with smooth bumps on its tube radius (normals from
-    the mesh)."""
-    import trimesh
-
-    minor = max(3, round(math.sqrt(faces / 4)))
-    mesh = trimesh.creation.torus(major_radius=2.0, minor_radius=0.7, major_sections=2 * minor,
-                                  minor_sections=minor)
-    rng = np.random.default_rng(seed)
-    vertices = np.array(mesh.vertices)
-    ring = vertices * [1, 1, 0]
-    ring = 2.0 * ring / np.linalg.norm(ring, axis=1, keepdims=True)
-    tube = vertices - ring
-    angle = np.arctan2(vertices[:, 1], vertices[:, 0])
-    height = np.arctan2(vertices[:, 2], np.linalg.norm(vertices[:, :2], axis=1) - 2.0)
-    bumps = 1 + 0.25 * np.sin(3 * angle + rng.uniform(0, 6)) * np.cos(2 * height + rng.uniform(0, 6))
-    vertices = ring + tube * bumps[:, None]
-    faces_ = np.asarray(mesh.faces)
-    mesh = trimesh.Trimesh(vertices, faces_, vertex_normals=vertex_normals(vertices, faces_), process=False)
-    return Scene.from_trimesh(mesh, name=f"torus {len(faces_)}")
+    """cltess.bench.scenes.bumpy_torus as a scene."""
+    mesh = scenes.bumpy_torus(faces, seed)
+    return Scene.from_trimesh(mesh, name=f"torus {len(mesh.faces)}")
 
 
 def cameras_for(scene: Scene, views: int, seed: int):

@@ -16,7 +16,7 @@ from cltess.backends.opencl.programs import STAGES, composition, program_text
 from cltess.criteria.tolerance import ObjectSpace, ScreenSpace
 from cltess.device import list_devices, probe_device
 from cltess.kinds import KINDS
-from cltess.patterns import PATTERNS
+from cltess.patterns import PATTERNS, SD2, pattern_named
 
 CPU_DEVICES = [info for info in list_devices() if info.type == "CPU" and probe_device(info).usable]
 
@@ -29,6 +29,14 @@ def compositions():
             for tolerance in (ObjectSpace(1.0), ScreenSpace(1.0, None)):
                 for stage in STAGES:
                     yield stage, composition(stage, kind=kind, pattern=pattern, tolerance=tolerance)
+            yield "vertex_rows", composition("vertex_rows", kind=kind, pattern=pattern)  # issue 15
+        semi_uniform = pattern_named("semi_uniform", kind.domain)
+        yield "level_vertices", composition("level_vertices", kind=kind, pattern=semi_uniform)  # by level
+        yield "level_indices", composition("level_indices", pattern=semi_uniform)
+        for stage in ("silhouette_alpha", "silhouette_levels", "silhouette_vertices"):  # per frame
+            yield stage, composition(stage, kind=kind, pattern=semi_uniform)
+    for stage in ("strip_counts", "strip_indices", "vertex_levels", "vertex_bounds", "level_factors"):  # SD-2
+        yield stage, composition(stage, pattern=SD2)
 
 
 @pytest.mark.parametrize("standard", ["CL1.2", "CL3.0"])

@@ -201,23 +201,6 @@ def test_no_pops_along_an_orbit(tessellator):
     assert fine < 0.5 * wide, (fine, wide)
 
 
-@pytest.mark.parametrize("standard", ["CL1.2", "CL3.0"])
-def test_the_sd2_stage_programs_build_under_both_standards(standard):
-    """The strip and level-function stages, as tests/test_kernel_portability.py builds STAGES."""
-    import pyopencl as cl
-
-    from cltess.backends.opencl.programs import composition, program_text
-    from cltess.device import list_devices, probe_device
-
-    devices = [info for info in list_devices() if info.type == "CPU" and probe_device(info).usable]
-    assert devices
-    for info in devices:
-        context = cl.Context([info.device])
-        for stage in ("strip_counts", "strip_indices", "vertex_levels", "vertex_bounds", "level_factors"):
-            source, options = program_text(stage, *composition(stage, pattern=SD2))
-            cl.Program(context, source).build(options=options + [f"-cl-std={standard}"])
-
-
 @pytest.mark.parametrize("function", ["bound", "silhouette", "depth"])
 def test_the_numpy_backend_agrees(tessellator, rng, function):
     """The NumPy backend's SD-2 (cltess.levels.reference_level_factors, the pattern's mirror)

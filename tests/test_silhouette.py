@@ -410,29 +410,6 @@ def test_silhouette_frames_with_creases_stay_closed(tessellator, cylinder, rng):
         assert welded.stats["welded_boundary_edges"] == 0 and welded.stats["welded_t_junctions"] == 0
 
 
-@pytest.mark.parametrize("standard", ["CL1.2", "CL3.0"])
-def test_the_silhouette_programs_build_under_both_standards(standard):
-    """As tests/test_kernel_portability.py does for the five stages, on every usable CPU device."""
-    import pyopencl as cl
-    from cltess.backends.opencl.programs import composition, program_text
-    from cltess.device import list_devices, probe_device
-    from cltess.kinds import KINDS
-    from cltess.patterns import pattern_named
-
-    devices = [info for info in list_devices() if info.type == "CPU" and probe_device(info).usable]
-    assert devices
-    for info in devices:
-        context = cl.Context([info.device])
-        for kind in KINDS:
-            pattern = pattern_named("semi_uniform", kind.domain)
-            for stage in ("silhouette_alpha", "silhouette_levels", "silhouette_vertices"):
-                source, options = program_text(stage, *composition(stage, kind=kind, pattern=pattern))
-                try:
-                    cl.Program(context, source).build(options=options + [f"-cl-std={standard}"])
-                except cl.RuntimeError as error:
-                    pytest.fail(f"{stage} ({kind.name}) fails as {standard} on {info.name}:\n{error}")
-
-
 def test_the_average_centre_of_eq_5(tessellator, sphere, rng):
     """centre="average": b111 is the mean of the six edge control points (eq. 5), every other
     control point bitwise PN's, the patch flatter, the frames still closed."""

@@ -166,6 +166,28 @@ def vertex_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     return summed / np.where(length > 0, length, 1)
 
 
+def bumpy_torus(faces: int, seed: int):
+    """A trimesh torus of about ``faces`` triangles (major sections twice the minor, radii 2 and
+    0.7), its tube radius modulated by smooth seeded bumps, with vertex normals: the mesh of the
+    size sweeps of bench/semi_uniform.py and bench/silhouette.py."""
+    import trimesh
+
+    minor = max(3, round(math.sqrt(faces / 4)))
+    mesh = trimesh.creation.torus(major_radius=2.0, minor_radius=0.7, major_sections=2 * minor,
+                                  minor_sections=minor)
+    rng = np.random.default_rng(seed)
+    vertices = np.array(mesh.vertices)
+    ring = vertices * [1, 1, 0]
+    ring = 2.0 * ring / np.linalg.norm(ring, axis=1, keepdims=True)
+    tube = vertices - ring
+    angle = np.arctan2(vertices[:, 1], vertices[:, 0])
+    height = np.arctan2(vertices[:, 2], np.linalg.norm(vertices[:, :2], axis=1) - 2.0)
+    bumps = 1 + 0.25 * np.sin(3 * angle + rng.uniform(0, 6)) * np.cos(2 * height + rng.uniform(0, 6))
+    vertices = ring + tube * bumps[:, None]
+    faces = np.asarray(mesh.faces)
+    return trimesh.Trimesh(vertices, faces, vertex_normals=vertex_normals(vertices, faces), process=False)
+
+
 def _mesh(vertices, faces):
     """A trimesh mesh (not merged or reordered) with its vertex normals set."""
     import trimesh

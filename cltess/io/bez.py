@@ -9,9 +9,9 @@ import numpy as np
 
 from ..limits import float32_problem
 from ..scene import Scene
-from .scene_cache import cached_patches
-from .text import (_FLOAT_TOKEN, _INDEX_BLOCK_BAD, _INT_TOKEN, _byte_set, _cartesian_rows, _clamped_int, _decode,
-                   _floats, _homogeneous, _Lines, _Numbers, _read_bytes)
+from .scene_cache import read_patch_file
+from .text import (_FLOAT_TOKEN, _INDEX_BLOCK_BAD, _INT_TOKEN, _byte_set, _cartesian_rows, _clamped_int,
+                   _floats, _homogeneous, _Lines, _Numbers)
 
 _INDEX_LINE_BYTES = _byte_set(b"0123456789, \t\n")
 
@@ -25,15 +25,7 @@ def read_patches(path) -> np.ndarray:
     """The file's (P, 4, 4, 4) homogeneous patches: parsed by NumPy at once (_fast_bez), or line
     by line where that finds something to report (_parse_bez, naming the line); a large file's
     from the binary cache when its bytes were parsed before (io/scene_cache.py)."""
-    data = _read_bytes(path)
-
-    def parse(data):
-        patches = _fast_bez(data)
-        if patches is None:
-            patches = _parse_bez(_Lines(str(path), _decode(path, data)))
-        return patches
-
-    return cached_patches(data, "bez", parse)
+    return read_patch_file(path, "bez", _fast_bez, _parse_bez)
 
 
 def _fast_bez(data: bytes) -> np.ndarray | None:

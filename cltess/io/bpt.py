@@ -10,8 +10,8 @@ import numpy as np
 
 from ..limits import float32_problem
 from ..scene import Scene
-from .scene_cache import cached_patches
-from .text import _cartesian_rows, _decode, _floats, _homogeneous, _Lines, _Numbers, _read_bytes
+from .scene_cache import read_patch_file
+from .text import _cartesian_rows, _floats, _homogeneous, _Lines, _Numbers
 
 _BPT_LINES_PER_PATCH = 17  # "3 3" + 16 points
 
@@ -25,15 +25,7 @@ def read_patches(path) -> np.ndarray:
     """The file's (P, 4, 4, 4) homogeneous patches: parsed by NumPy at once (_fast_bpt), or line
     by line where that finds something to report (_parse_bpt, naming the line); a large file's
     from the binary cache when its bytes were parsed before (io/scene_cache.py)."""
-    data = _read_bytes(path)
-
-    def parse(data):
-        patches = _fast_bpt(data)
-        if patches is None:
-            patches = _parse_bpt(_Lines(str(path), _decode(path, data)))
-        return patches
-
-    return cached_patches(data, "bpt", parse)
+    return read_patch_file(path, "bpt", _fast_bpt, _parse_bpt)
 
 
 def _fast_bpt(data: bytes) -> np.ndarray | None:

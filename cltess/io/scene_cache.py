@@ -16,6 +16,7 @@ from typing import Callable
 
 import numpy as np
 
+from .text import _decode, _Lines, _read_bytes
 from .writing import atomic_write
 
 #: Smaller files parse in milliseconds: not worth a cache entry.
@@ -52,3 +53,17 @@ def cached_patches(data: bytes, kind: str, parse: Callable[[bytes], np.ndarray])
     except OSError:
         pass
     return patches
+
+
+def read_patch_file(path, kind: str, fast: Callable[[bytes], np.ndarray | None],
+                    slow: Callable[[_Lines], np.ndarray]) -> np.ndarray:
+    """A patch file's (P, 4, 4, 4) homogeneous patches: ``fast(data)`` (NumPy at once; None for
+    anything it would not take), else ``slow`` line by line (which names the line at fault); a
+    large file's from this cache when the same bytes were parsed before."""
+    data = _read_bytes(path)
+
+    def parse(data):
+        patches = fast(data)
+        return patches if patches is not None else slow(_Lines(str(path), _decode(path, data)))
+
+    return cached_patches(data, kind, parse)

@@ -43,14 +43,8 @@ inline int4 esc_factors(__global const float4 *source, uint p, tolerance_args to
 {
     float4 b[16];
     load_patch(source, p, b);
-    float3 lo = b[0].xyz / b[0].w, hi = lo;
-    for (int k = 1; k < 16; ++k) {
-        float3 point = b[k].xyz / b[k].w;
-        lo = min(lo, point);
-        hi = max(hi, point);
-    }
     int culled;
-    float eps = patch_tolerance(lo, hi, tol, &culled);
+    float eps = bezier_tolerance(b, tol, &culled);
     if (culled) {
         *flags = FLAG_CULLED;
         return (int4)(0);

@@ -138,6 +138,19 @@ inline void edge_controls(const float4 b[16], int e, float4 c[4])
     }
 }
 
+/* The tolerance of a patch at its control points' bounding box (criteria/tolerance.h
+ * patch_tolerance; the convex hull holds the patch); *culled when the box is out of view. */
+ALWAYS_INLINE float bezier_tolerance(__private const float4 b[16], tolerance_args tol, __private int *culled)
+{
+    float3 lo = b[0].xyz / b[0].w, hi = lo;
+    for (int k = 1; k < 16; ++k) {
+        float3 point = b[k].xyz / b[k].w;
+        lo = min(lo, point);
+        hi = max(hi, point);
+    }
+    return patch_tolerance(lo, hi, tol, culled);
+}
+
 /* --- the kind contract (docs/extending.md) ----------------------------------------------------- */
 
 /* Stage 1: factors (m, n, m, n) by edge from the Zheng-Sederberg bound; *flags as FLAG_*.
@@ -151,14 +164,8 @@ inline int4 kind_factors(__global float4 *source, __global float4 *controls, uin
 {
     float4 b[16];
     load_patch(controls, p, b);
-    float3 lo = b[0].xyz / b[0].w, hi = lo;
-    for (int k = 1; k < 16; ++k) {
-        float3 point = b[k].xyz / b[k].w;
-        lo = min(lo, point);
-        hi = max(hi, point);
-    }
     int culled;
-    float eps = patch_tolerance(lo, hi, tol, &culled);
+    float eps = bezier_tolerance(b, tol, &culled);
     if (culled) {
         *flags = FLAG_CULLED;
         return (int4)(0);

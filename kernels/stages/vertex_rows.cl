@@ -6,6 +6,8 @@
  * patch side by side; the last of them also does every row beyond it, so any rows_per_patch
  * >= 1 is right (the host gives max_factor + 1: no pattern has more rows than its largest
  * factor). */
+#include "stages/rows.h"
+
 __kernel void vertex_rows(__global const float4 *controls, __global const int4 *factors,
                           __global const ulong *vertex_offsets, __global const int *patch_objects,
                           uint first_patch, uint num_patches, uint patch_base, ulong vertex_base,
@@ -30,19 +32,8 @@ __kernel void vertex_rows(__global const float4 *controls, __global const int4 *
     kind_patch patch;
     kind_load(controls, p - patch_base, &patch);
     ulong at = vertex_offsets[p] - vertex_base;
-    float3 position, normal;
-
     if (first_row == 0) {
-        __attribute__((opencl_unroll_hint))
-        for (int e = 0; e < PATTERN_EDGES; ++e)
-            for (int k = 0; k < PATTERN_EDGE_POINTS(f, e); ++k) {  /* patterns/layout.h */
-                edge_param t = pattern_ring_param(f, e, k);
-                float3 x = pattern_edge_point(e, t);
-                kind_eval(&patch, x, 0, &normal);
-                edge_param corner = {0, t.f};
-                put_vertex(out, at++, kind_boundary_point(&patch, e, (collapsed >> e) & 1 ? corner : t), normal,
-                           x.xy, p, object);
-            }
+        at = put_ring(&patch, f, collapsed, out, at, p, object);  /* stages/rows.h */
         first_row = 1;
     } else {
         for (int e = 0; e < PATTERN_EDGES; ++e)  /* the ring */
@@ -50,26 +41,5 @@ __kernel void vertex_rows(__global const float4 *controls, __global const int4 *
         for (int j = 1; j < first_row; ++j)
             at += (ulong)(pattern_row(f, j) - 1);
     }
-
-#if !PATTERN_UNIFORM_ROWS
-    forward_differencing = 0;  /* the rows' points are not equally spaced (patterns/layout.h) */
-#endif
-    for (int j = first_row; j <= last_row; ++j) {
-        int steps = pattern_row(f, j);
-        if (forward_differencing) {
-            kind_row row;
-            kind_row_begin(&patch, pattern_row_point(f, j, 0), pattern_row_point(f, j, steps), steps, &row);
-            for (int i = 1; i < steps; ++i) {
-                float3 x = pattern_row_point(f, j, i);
-                kind_row_next(&patch, &row, x, &position, &normal);
-                put_vertex(out, at++, position, normal, x.xy, p, object);
-            }
-        } else {
-            for (int i = 1; i < steps; ++i) {
-                float3 x = pattern_row_point(f, j, i);
-                kind_eval(&patch, x, &position, &normal);
-                put_vertex(out, at++, position, normal, x.xy, p, object);
-            }
-        }
-    }
+    put_rows(&patch, f, first_row, last_row, forward_differencing, out, at, p, object);
 }
