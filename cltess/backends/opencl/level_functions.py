@@ -24,6 +24,16 @@ def _global_size(n: int) -> tuple[int]:
     return size(n)
 
 
+def build_level_programs(tessellator) -> None:
+    """Build the level functions' kernels and pyopencl's float32 min and max reductions now,
+    before a plan's buffers exist (Tessellator.compose: a build after them makes Oclgrind's
+    uninitialised-value plugin report what the scans write)."""
+    for stage in ("vertex_levels", "vertex_bounds", "level_factors"):
+        tessellator.programs.kernel(stage)
+    probe = cl_array.zeros(tessellator.queue, 1, np.float32)
+    cl_array.min(probe).get(), cl_array.max(probe).get()
+
+
 def level_factors(tessellator, scene, request, part, factors) -> tuple[list, dict]:
     """Overwrite ``factors`` (P, 4) int32 of ``part``'s patches (a PlanPart of a fixed-point
     pattern, stage 1 done) with the level function's fixed-point factors.  Returns (events,

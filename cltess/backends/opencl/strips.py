@@ -24,6 +24,12 @@ def strip_parts(parts) -> list:
     return [part for part in parts if part.pattern.primitive == "strips"]
 
 
+def build_strip_programs(tessellator, pattern) -> None:
+    """Build a strip pattern's two kernels now, before a plan's buffers exist (Tessellator.compose)."""
+    for stage in ("strip_counts", "strip_indices"):
+        tessellator.programs.kernel(stage, pattern=pattern)
+
+
 def strip_offsets(tessellator, factors, parts) -> tuple[cl_array.Array, list]:
     """(offsets (P+1,) uint64 of the strip indices of every patch, 0 for the patches of other
     patterns, the total last; events) from the final factors."""

@@ -38,9 +38,9 @@ from ...patterns.semi_uniform import DEFAULT_MAX_LEVEL, level_histogram
 from ...request import Request
 from ...scene import Scene
 from ...tessellation import BYTES_PER_INDEX, BYTES_PER_VERTEX, VERTEX_RECORD, DeviceOutput, Tessellation
-from .level_functions import level_factors
+from .level_functions import build_level_programs, level_factors
 from .programs import Programs
-from .strips import emit_strips, strip_offsets, strip_parts
+from .strips import build_strip_programs, emit_strips, strip_offsets, strip_parts
 
 WORK_GROUP = 64  # global sizes are rounded up to this; kernels guard their index
 #: stages/vertex_rows.cl: work-items per patch (the ring and 64 rows; a patch with more rows has
@@ -138,7 +138,12 @@ class Tessellator:
         tolerance = request.tolerance_for(scene)
         for kind in KINDS:
             if kind.count(scene):
-                self.programs.compose(kind, request.pattern_for(kind), tolerance)
+                pattern = request.pattern_for(kind)
+                self.programs.compose(kind, pattern, tolerance)
+                if pattern.fixed_point:  # SD-2's level functions
+                    build_level_programs(self)
+                if pattern.primitive == "strips":
+                    build_strip_programs(self, pattern)
 
     def scene_data(self, scene: Scene, sharp_edges: str = "straight") -> "SceneData":
         """What stays on the device for a scene whatever the tolerance or camera: every kind's
