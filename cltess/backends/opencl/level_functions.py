@@ -24,7 +24,7 @@ def _global_size(n: int) -> tuple[int]:
     return size(n)
 
 
-def build_level_programs(tessellator) -> None:
+def build_level_function_programs(tessellator) -> None:
     """Build the level functions' kernels and pyopencl's float32 min and max reductions now,
     before a plan's buffers exist (Tessellator.compose: a build after them makes Oclgrind's
     uninitialised-value plugin report what the scans write)."""

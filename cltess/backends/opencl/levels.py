@@ -81,16 +81,6 @@ def level_templates(tessellator: Tessellator, domain: str, level: int) -> tuple[
     return _TEMPLATES[key]
 
 
-def build_level_programs(tessellator: Tessellator, kind, pattern) -> None:
-    """Build the by-level kernels of a (kind, pattern) and the scan now, before a plan's buffers
-    exist (a build after them makes Oclgrind's uninitialised-value plugin report the scans'
-    output, tests/test_oclgrind.py)."""
-    tessellator.programs.kernel("level_vertices", kind=kind, pattern=pattern)
-    tessellator.programs.kernel("level_indices", pattern=pattern, entry="level_interior")
-    tessellator.programs.kernel("level_indices", pattern=pattern, entry="level_band")
-    level_scan(tessellator.context)
-
-
 def plan_by_level(tessellator: Tessellator, scene, request) -> Plan:
     """``tessellator.plan`` for ``request`` with emit="by_level" (whatever the request says)."""
     from dataclasses import replace

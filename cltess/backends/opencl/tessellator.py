@@ -38,7 +38,7 @@ from ...patterns.semi_uniform import DEFAULT_MAX_LEVEL, level_histogram
 from ...request import Request
 from ...scene import Scene
 from ...tessellation import BYTES_PER_INDEX, BYTES_PER_VERTEX, VERTEX_RECORD, DeviceOutput, Tessellation
-from .level_functions import build_level_programs, level_factors
+from .level_functions import build_level_function_programs, level_factors
 from .programs import Programs
 from .strips import build_strip_programs, emit_strips, strip_offsets, strip_parts
 
@@ -141,7 +141,7 @@ class Tessellator:
                 pattern = request.pattern_for(kind)
                 self.programs.compose(kind, pattern, tolerance)
                 if pattern.fixed_point:  # SD-2's level functions
-                    build_level_programs(self)
+                    build_level_function_programs(self)
                 if pattern.primitive == "strips":
                     build_strip_programs(self, pattern)
 
@@ -150,7 +150,7 @@ class Tessellator:
         upload (``upload``), the object ids and the edge groups of stage 2.  The host side
         (adjacency, welding) is cached on the scene (``Scene.prepared``)."""
         kinds = [kind for kind in KINDS if kind.count(scene)]
-        parts, inputs, base, events = [], [], 0, {}
+        parts, inputs, base = [], [], 0
         for kind in kinds:
             count = kind.count(scene)
             host = scene.prepared((kind.name, sharp_edges), lambda: kind.prepare(scene, sharp_edges))
@@ -167,7 +167,7 @@ class Tessellator:
         }
         for host in inputs:
             stats.update(host.stats)
-        return SceneData(scene, sharp_edges, base, parts, objects, self.upload_groups(groups, base), stats, events)
+        return SceneData(scene, sharp_edges, base, parts, objects, self.upload_groups(groups, base), stats)
 
     def plan_on(self, data: "SceneData", request: Request, started: float | None = None,
                 scratch: dict | None = None) -> "Plan":
@@ -184,7 +184,7 @@ class Tessellator:
             scratch["factors"] = cl_array.empty(self.queue, (count, FACTOR_SLOTS), np.int32)
             scratch["flags"] = cl_array.empty(self.queue, count, np.int32)
         factors, flags = scratch["factors"], scratch["flags"]
-        events, data.events = {**data.events, "factors": []}, {}
+        events = {"factors": []}
         for part in parts:
             events["factors"] += self.stage_factors_of(part.kind, part.data, tolerance, request.max_factor,
                                                        factors, flags, part.base, part.pattern, request.max_level)
@@ -739,7 +739,6 @@ class SceneData:
     objects: cl_array.Array
     groups: dict
     stats: dict
-    events: dict = field(default_factory=dict)  # the uploads' events, reported by the next plan
 
 
 @dataclass
