@@ -9,7 +9,8 @@ from cltess.bound import worst_bound_ratio
 from cltess.checks import t_junctions
 from cltess.crack.adjacency import edge_groups
 from cltess.criteria.tolerance import ObjectSpace
-from cltess.esc.masks import esc_stage
+from cltess.esc.masks import candidate_tested, esc_stage, patch_levels, patch_steps
+from cltess.criteria.zheng_sederberg import zs_factors
 from cltess.io import load_scene
 from cltess.patterns import esc
 from cltess.request import Request
@@ -176,9 +177,11 @@ def test_stage_1_on_random_patches_equals_the_mirror_but_at_the_threshold(tessel
         host = NumpyBackend().plan(scene, request).factors
         differ = np.flatnonzero((device != host).any(axis=1))
         assert len(differ) < 0.05 * len(patches)
-        for p in range(10):  # the distances below are the ones the mirror tested
+        levels = host_levels(scene, request)
+        for p in range(10):  # the distances below are the ones the mirror tested (its own level's)
+            tested = sum(1 << (k - 1) for k in (1, 2, 3) if candidate_tested(k, levels[p] + 1, 3))
             bits = ((candidate_distances(patches[p], 3) > eps) * (1 << np.arange(3))).sum(axis=1)
-            assert np.array_equal(bits, esc.unpack(np.abs(host[p]))[1])
+            assert np.array_equal(bits & tested, esc.unpack(np.abs(host[p]))[1])
         for p in differ:
             _, got = esc.unpack(np.abs(device[p]))
             _, expected = esc.unpack(np.abs(host[p]))
@@ -186,3 +189,93 @@ def test_stage_1_on_random_patches_equals_the_mirror_but_at_the_threshold(tessel
             size = np.abs(patches[p, ..., :3] / patches[p, ..., 3:]).max()
             for c, k in zip(*np.nonzero(((got ^ expected)[:, None] >> np.arange(3)) & 1)):
                 assert abs(distances[c, k] - eps) < 1e-4 * size, (p, c, k, distances[c, k], eps)
+
+
+# --- per-patch levels (docs/esc.md decision 5) -------------------------------------------------
+
+def host_levels(scene, request):
+    """(P,) the levels L_p the mirror gives the scene's patches (from the float64 bound)."""
+    patches = np.asarray(scene.patches, np.float64).reshape(-1, 4, 4, 4)
+    points = (patches[..., :3] / patches[..., 3:]).reshape(len(patches), -1, 3)
+    eps, culled = request.tolerance_for(scene).reference(points.min(axis=1), points.max(axis=1))
+    return patch_levels(zs_factors(patches, eps, culled, request.max_factor)[0], request.max_level)
+
+
+def test_patch_levels_lie_on_the_lattice_and_grow_with_the_bound():
+    """L_p + 1 divides L + 1 (its candidates are the lattice's), 3 (L_p + 1) segments meet the
+    factor where the lattice allows, and the tested candidates only grow with the factor."""
+    assert [patch_steps(f, 3) - 1 for f in (0, 1, 3, 4, 6, 7, 12, 13, 64)] == [0, 0, 0, 1, 1, 3, 3, 3, 3]
+    assert [patch_steps(f, 2) - 1 for f in (1, 3, 4, 9, 10)] == [0, 0, 2, 2, 2]
+    for level in range(4):
+        n, previous = level + 1, set()
+        for factor in range(0, 3 * n + 5):
+            steps = patch_steps(factor, level)
+            assert n % steps == 0 and (3 * steps >= factor or steps == n)
+            tested = {k for k in range(1, n) if candidate_tested(k, steps, level)}
+            assert previous <= tested and len(tested) == steps - 1
+            previous = tested
+        assert previous == set(range(1, n))
+
+
+def test_per_patch_levels_device_equals_the_mirror_and_test_a_subset(tessellator):
+    """Eps where the teacup's patches get different levels: device records and triangles equal
+    the mirror's; each patch's masks are a subset of the all-L-3 test's, only on its level's
+    candidates."""
+    scene = load_scene(SCENES / "teacup.bez")
+    for eps in (0.0142, 0.05):
+        request = Request.of(eps=eps, pattern="esc")
+        levels = host_levels(scene, request)
+        assert len(set(levels.tolist())) >= 2, levels
+        device, host = tessellator.tessellate(scene, request), NumpyBackend().tessellate(scene, request)
+        assert np.array_equal(device.factors, host.factors)
+        assert np.array_equal(device.triangles, host.triangles)
+        own, _ = esc_stage(scene.patches, request.tolerance_for(scene), 3)
+        full, _ = esc_stage(scene.patches, request.tolerance_for(scene), 3, levels=np.full(scene.num_patches, 3))
+        for p in range(scene.num_patches):
+            mine, everything = esc.unpack(own[p])[1], esc.unpack(full[p])[1]
+            tested = sum(1 << (k - 1) for k in (1, 2, 3) if candidate_tested(k, levels[p] + 1, 3))
+            assert np.array_equal(mine, everything & tested)
+
+
+def test_random_patch_levels_stay_watertight(tessellator, rng, monkeypatch):
+    """Random levels per patch (every divisor level of the lattice, neighbours differing), through
+    the mirror's stage 1 and OR, then the device's stages 4-5 (Tessellator.upload_plan): bitwise
+    watertight with 0 T-junctions; a shared edge's bits equal on both sides after the OR."""
+    import dataclasses
+
+    import cltess.esc.masks as masks
+    for max_level in (1, 2, 3):
+        allowed = [d - 1 for d in range(1, max_level + 2) if (max_level + 1) % d == 0]
+        monkeypatch.setattr(masks, "patch_levels", lambda f, level: rng.choice(allowed, len(f)))
+        for name, scene in closed_scenes(rng):
+            for eps in 10.0 ** rng.uniform(-3.5, -1.5, 2):
+                request = Request.of(eps=float(eps), pattern="esc", max_level=max_level)
+                host = NumpyBackend().plan(scene, request)
+                device = tessellator.plan(scene, request).to_host()
+                device = dataclasses.replace(device, factors=host.factors, vertex_offsets=host.vertex_offsets,
+                                             index_offsets=host.index_offsets, num_vertices=host.num_vertices,
+                                             num_indices=host.num_indices)
+                tess = tessellator.emit(tessellator.upload_plan(device), 0, scene.num_patches)
+                assert_closed(tess)
+                groups = edge_groups(scene.patches)
+                flat = np.abs(host.factors).reshape(-1)
+                for g in range(groups.num_groups):
+                    members = groups.members[groups.group_start[g]:groups.group_start[g + 1]]
+                    assert len(set((flat[members] & esc.BOUNDARY_BITS).tolist())) == 1
+
+
+def test_max_level_1_to_3_closed_and_monotone(tessellator, rng):
+    """--max-level 1, 2, 3 (and the default) with per-patch levels: watertight, 0 T-junctions,
+    device == mirror, triangle count monotone in eps."""
+    scene = closed_torus_grid(rng, 6, 4, noise=0.2)
+    for max_level in (1, 2, 3, None):
+        options = {} if max_level is None else {"max_level": max_level}
+        previous = None
+        for eps in sorted(10.0 ** rng.uniform(-3.5, -0.5, 4), reverse=True):
+            request = Request.of(eps=float(eps), pattern="esc", **options)
+            device, host = tessellator.tessellate(scene, request), NumpyBackend().tessellate(scene, request)
+            assert np.array_equal(device.factors, host.factors)
+            assert np.array_equal(device.triangles, host.triangles)
+            assert_closed(device)
+            assert previous is None or len(device.triangles) >= previous
+            previous = len(device.triangles)

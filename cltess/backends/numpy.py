@@ -147,7 +147,7 @@ class NumpyBackend:
             if pattern.dyadic:  # stage 1's rounding (common.h dyadic_factors)
                 f, fl = dyadic_stage(f, fl, request.max_level)
             if pattern.stage1:  # the pattern's own stage 1 (ESC: candidate masks)
-                f, fl = pattern.stage1[1](controls, request.tolerance_for(scene), request.max_level)
+                f, fl = pattern.stage1[1](controls, request.tolerance_for(scene), request.max_level, request.max_factor)
             if pattern.fixed_point:  # a level function's fixed-point factors (SD-2)
                 from ..levels import reference_level_factors
                 f, level_stats = reference_level_factors(scene, request, f)

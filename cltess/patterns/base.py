@@ -27,7 +27,7 @@ class Pattern:
                function (cltess.levels) rather than by the kinds' integer stage 1.
     stage1:    its own stage 1 instead of the kind's factors, ``(defines, host)``: stage 1 is
                built with these ``-D`` defines (``(("PATTERN_ESC", 1),)``), and ``host(patches,
-               tolerance, max_level) -> (records, flags)`` is its NumPy mirror (ESC: the candidate
+               tolerance, max_level, max_factor) -> (records, flags)`` is its NumPy mirror (ESC: the candidate
                masks; cltess/esc/masks.py).
     layout:    the NumPy mirror, f -> (uv (V, 2) float64, triangles (T, 3) int64 local indices):
                the ring first, then the interior rows, as the device lays the vertices out.

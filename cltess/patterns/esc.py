@@ -333,9 +333,9 @@ def strips(f) -> np.ndarray:
     return patch_mesh(level, masks, collapsed)[2]
 
 
-def _stage1(patches, tolerance, max_level):
+def _stage1(patches, tolerance, max_level, max_factor):
     from ..esc.masks import esc_stage  # noqa: PLC0415 (esc.masks imports this module)
-    return esc_stage(patches, tolerance, max_level)
+    return esc_stage(patches, tolerance, max_level, max_factor)
 
 
 ESC = Pattern("esc", "quad", 4, "patterns/esc.h", layout, crack="crack/or_masks.h",
