@@ -279,3 +279,62 @@ def test_max_level_1_to_3_closed_and_monotone(tessellator, rng):
             assert_closed(device)
             assert previous is None or len(device.triangles) >= previous
             previous = len(device.triangles)
+
+
+# --- strips from the device (patterns/esc.h pattern_strips, cltess/backends/opencl/strips.py) ---
+
+def test_device_strips_equal_the_mirror_on_random_records(tessellator, rng):
+    """Random records (levels 0..3, every mask density, collapsed edges, culled): the strip counts
+    and the strips of stages 3 and 5 equal esc.strip_indices, a batch in the middle the same slice,
+    and they expand to exactly stage 5's triangle list (order and winding included)."""
+    from types import SimpleNamespace
+
+    import pyopencl.array as cl_array
+
+    from cltess.backends.opencl.strips import emit_strips, strip_offsets
+    from cltess.strips import expand_strips
+    from support.factors import random_esc_records
+    factors = random_esc_records(rng, 400)
+    count = len(factors)
+    device = cl_array.to_device(tessellator.queue, factors)
+    vertex_offsets, index_offsets, _ = tessellator.stage_counts(device, [(esc.ESC, 0, count)])
+    part = SimpleNamespace(pattern=esc.ESC, base=0, count=count)
+    offsets, _ = strip_offsets(tessellator, device, [part])
+    expected_local = [esc.strip_indices(f) for f in factors]
+    assert np.array_equal(np.diff(offsets.get()), [len(s) for s in expected_local])
+    plan = SimpleNamespace(num_patches=count, num_strip_indices=int(offsets[count].get()), strip_offsets=offsets,
+                           parts=[part], factors=device, vertex_offsets=vertex_offsets)
+    strips, _ = emit_strips(tessellator, plan, 0, count)
+    firsts = vertex_offsets.get()
+    expected = np.concatenate([np.where(s == 0xFFFFFFFF, s, s + firsts[p]) for p, s in enumerate(expected_local)])
+    assert np.array_equal(strips.astype(np.int64), expected[:-1])
+    middle, _ = emit_strips(tessellator, plan, 100, 300)
+    host = offsets.get()
+    assert np.array_equal(middle, strips[host[100]:host[300] - 1])
+    triangles, _ = tessellator.stage_indices(device, vertex_offsets, index_offsets,
+                                             (0, int(index_offsets[count].get())), (0, count), kind=esc.ESC)
+    assert np.array_equal(expand_strips(strips, drop_degenerate=True), triangles.get())
+
+
+def test_strips_on_scenes_equal_the_mirror_expand_to_the_triangles_and_keep_in_npz(tessellator, rng, tmp_path):
+    """--pattern esc fills Tessellation.strips on the device: equal to the NumPy backend's, expanding
+    (zero-area rule-4 copies and collapsed sides dropped) to the triangle list in its order, so with
+    its winding; the NPZ keeps them; a batched run gives the same strips."""
+    from cltess.io.npz import load_npz, write_npz
+    from cltess.strips import expand_strips, split_strips
+    scenes = [("teapot", load_scene(SCENES / "teapot.bez"), Request.of(eps=1e-2, pattern="esc")),
+              ("teacup", load_scene(SCENES / "teacup.bez"), Request.of(eps=0.05, pattern="esc")),
+              ("torus_grid", closed_torus_grid(rng, 6, 4, noise=0.2), Request.of(eps=3e-3, pattern="esc", max_level=2))]
+    for name, scene, request in scenes:
+        device, host = tessellator.tessellate(scene, request), NumpyBackend().tessellate(scene, request)
+        assert device.strips is not None and len(device.strips), name
+        assert np.array_equal(device.strips, host.strips), name
+        assert np.array_equal(expand_strips(device.strips, drop_degenerate=True), device.triangles), name
+        assert all(len(s) >= 3 for s in split_strips(device.strips))
+        write_npz(device, tmp_path / f"{name}.npz")
+        assert np.array_equal(load_npz(tmp_path / f"{name}.npz").strips, device.strips)
+    batched = list(tessellator.tessellate_in_batches(scene, 20_000, request)[1])
+    assert len(batched) > 1
+    joined = [b.strips for b in batched if len(b.strips)]
+    parts = [joined[0]] + [np.concatenate([[0xFFFFFFFF], s]) for s in joined[1:]]
+    assert np.array_equal(np.concatenate(parts).astype(np.uint32), device.strips)
