@@ -237,6 +237,24 @@ def test_per_patch_levels_device_equals_the_mirror_and_test_a_subset(tessellator
             assert np.array_equal(mine, everything & tested)
 
 
+def test_one_level_variant_equals_the_mirror_and_inserts_a_superset(tessellator, monkeypatch):
+    """esc.ESC_ONE_LEVEL (bench/esc.py's baseline: every patch at L): device == mirror, and its
+    masks contain the per-patch levels' masks."""
+    from cltess.patterns import PATTERNS
+    monkeypatch.setitem(PATTERNS, "esc_one_level", esc.ESC_ONE_LEVEL)
+    scene = load_scene(SCENES / "teacup.bez")
+    for eps in (0.0142, 0.05):
+        one = Request.of(eps=eps, pattern="esc_one_level")
+        device, host = tessellator.tessellate(scene, one), NumpyBackend().tessellate(scene, one)
+        assert np.array_equal(device.factors, host.factors)
+        assert np.array_equal(device.triangles, host.triangles)
+        per_patch = tessellator.tessellate(scene, eps=eps, pattern="esc").factors
+        for a, b in zip(per_patch, device.factors):
+            mine, everything = esc.unpack(np.abs(a))[1], esc.unpack(np.abs(b))[1]
+            assert ((mine & everything) == mine).all()
+        assert len(tessellator.tessellate(scene, eps=eps, pattern="esc").triangles) <= len(device.triangles)
+
+
 def test_random_patch_levels_stay_watertight(tessellator, rng, monkeypatch):
     """Random levels per patch (every divisor level of the lattice, neighbours differing), through
     the mirror's stage 1 and OR, then the device's stages 4-5 (Tessellator.upload_plan): bitwise

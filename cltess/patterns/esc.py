@@ -346,5 +346,16 @@ def _stage1(patches, tolerance, max_level, max_factor):
     return esc_stage(patches, tolerance, max_level, max_factor)
 
 
+def _stage1_one_level(patches, tolerance, max_level, max_factor):
+    from ..esc.masks import esc_stage  # noqa: PLC0415
+    return esc_stage(patches, tolerance, max_level, max_factor, levels=np.full(len(patches), min(max_level, MAX_LEVEL)))
+
+
 ESC = Pattern("esc", "quad", 4, "patterns/esc.h", layout, crack="crack/or_masks.h", primitive="strips",
               stage1=((("PATTERN_ESC", 1),), _stage1), strips=strip_indices)
+
+#: ESC with one level per run (every patch at L = max level, as before per-patch levels): not in
+#: the registry; bench/esc.py adds it to PATTERNS to measure what per-patch levels change.
+ESC_ONE_LEVEL = Pattern("esc_one_level", "quad", 4, "patterns/esc.h", layout, crack="crack/or_masks.h",
+                        primitive="strips", stage1=((("PATTERN_ESC", 1), ("ESC_ONE_LEVEL", 1)), _stage1_one_level),
+                        strips=strip_indices)

@@ -82,6 +82,9 @@ inline int4 esc_factors(__global float4 *source, __global float4 *controls, uint
         if (point)
             steps = n;
     }
+#ifdef ESC_ONE_LEVEL
+    steps = n;  /* one level per run, every patch at L (esc.py ESC_ONE_LEVEL: bench/esc.py's baseline) */
+#endif
     /* saturated: the bound asks for more than the lattice has (or than max_factor) */
     *flags = (*flags & FLAG_SATURATED) | (factor > m ? FLAG_SATURATED : 0);
     int slots[4];
