@@ -4,6 +4,7 @@ what the paper could not show: triangles against measured error for ESC, Zheng-S
 and uniform tessellation.
 
     python bench/esc.py [--device NAME] [--repeat 3] [--big 8110] [--json OUT] [--plot PNG] [--csv OUT]
+    python bench/esc.py --levels [--device NAME] [--repeat 3] [--big 8110] [--json OUT]
 
 Scenes: Teacups = 100 copies of scenes/teacup.bez on a 10 x 10 grid (translated only, 2,600
 patches) and an 8,110-patch substitute for the paper's Elephants (bigguy.bez copies,
@@ -22,6 +23,13 @@ Error: max |S(u, v) - mesh(u, v)| over order-4 barycentric samples of the triang
 copy at the scene's eps for Teacups (every copy is the same mesh up to translation), every k-th
 triangle of the big scene (at most --error-triangles; a sampled maximum, so a lower bound).
 "dev/eps" is that deviation over the eps the row was made with.
+
+Per-patch levels (--levels; docs/esc.md decision 5): ESC as it is (each patch tests the
+candidates of its own level L_p from the Zheng-Sederberg factor, on the L = 3 lattice) against
+esc.ESC_ONE_LEVEL (every patch at L = 3, one level per run, as before), at the Table 1 eps of each
+scene (the "high" and "medium" of bench/RESULTS.md, issue 14) and coarser ones: triangles, the
+patches' levels, the measured deviation / eps (as above), device ms of stages 1-5 (strips
+included) and of stage 1 alone, medians of --repeat.
 
 Evaluators (step 1 of issue 14): direct Bernstein, NBM-Horner and forward differencing on a
 13 x 13 grid of every Teacups patch (kernels/esc/evaluate_grid.cl): kernel time (profiling, best
@@ -181,6 +189,53 @@ def curves(tessellator, scene, sample_triangles, diagonal: float) -> list[dict]:
     return points
 
 
+#: The eps of the per-patch level comparison, as fractions of what Table 1 found (RESULTS.md,
+#: issue 14): Teacups "high" 0.00412, "medium" 0.0142; bigguy 8,110 "high" 0.000237, "medium" 0.000747.
+LEVEL_EPS = {"teacups": (0.00412, 0.0142, 0.03, 0.06), "bigguy": (0.000237, 0.000747, 0.002, 0.005)}
+
+
+def stage_ms(tessellator, scene, request, repeat: int) -> tuple[float, float, object]:
+    """(median device ms of stages 1-5, median ms of stage 1, last Tessellation) after a warm-up."""
+    tessellator.tessellate(scene, request)
+    totals, firsts, tess = [], [], None
+    for _ in range(repeat):
+        tess = tessellator.tessellate(scene, request)
+        totals.append(device_ms(tess))
+        firsts.append(tess.stage_ms["factors"])
+    return float(np.median(totals)), float(np.median(firsts)), tess
+
+
+def level_rows(tessellator, scene, error_scene, eps_values, repeat: int, sample_triangles) -> list[dict]:
+    """Per-patch levels against one level per run at each eps (module docstring)."""
+    from cltess.criteria.zheng_sederberg import zs_factors
+    from cltess.esc.masks import patch_levels
+    from cltess.patterns import PATTERNS
+    from cltess.patterns.esc import ESC_ONE_LEVEL
+
+    PATTERNS.setdefault(ESC_ONE_LEVEL.name, ESC_ONE_LEVEL)  # not in the registry: the baseline only
+    patches = np.asarray(scene.patches, np.float64).reshape(-1, 4, 4, 4)
+    points = (patches[..., :3] / patches[..., 3:]).reshape(len(patches), -1, 3)
+    rows = []
+    for eps in eps_values:
+        tolerance = Request.of(eps=eps).tolerance_for(scene)
+        bound_eps, culled = tolerance.reference(points.min(axis=1), points.max(axis=1))
+        levels = np.bincount(patch_levels(zs_factors(patches, bound_eps, culled)[0], 3), minlength=4)
+        for name, pattern in (("per-patch L_p", "esc"), ("one L = 3", ESC_ONE_LEVEL.name)):
+            request = Request.of(eps=eps, pattern=pattern, max_level=3)
+            total, first, tess = stage_ms(tessellator, scene, request, repeat)
+            measured = tess if error_scene is scene else tessellator.tessellate(error_scene, request)
+            dev = deviation(error_scene, measured, sample_triangles)
+            rows.append({"scene": scene.name, "row": name, "eps": eps, "triangles": len(tess.triangles),
+                         "levels_0_1_3": [int(levels[0]), int(levels[1]), int(levels[3])] if pattern == "esc" else None,
+                         "max_dev": dev, "dev_over_eps": dev / eps, "device_ms": total, "stage1_ms": first,
+                         "strip_indices": len(tess.strips)})
+            r = rows[-1]
+            shown = f"L_p 0/1/3: {r['levels_0_1_3']}" if r["levels_0_1_3"] else ""
+            print(f"  eps {eps:<9.3g} {name:<14} tris {r['triangles']:>9,}  dev/eps {r['dev_over_eps']:6.2f}  "
+                  f"device {total:8.2f} ms  stage 1 {first:6.2f} ms  {shown}", flush=True)
+    return rows
+
+
 def print_row(r: dict) -> None:
     eps = f"{r['eps']:.3g}" if r["eps"] else "-"
     ratio = f"{r['dev_over_eps']:.2f}" if r["dev_over_eps"] is not None else "-"
@@ -215,6 +270,8 @@ def main(argv=None) -> int:
     parser.add_argument("--error-triangles", type=int, default=100_000,
                         help="the big scene's error: every k-th triangle, at most this many")
     parser.add_argument("--evaluators-only", action="store_true", help="only the evaluator timings")
+    parser.add_argument("--levels", action="store_true",
+                        help="only per-patch levels against one level per run (docs/esc.md decision 5)")
     parser.add_argument("--json", type=Path)
     parser.add_argument("--csv", type=Path, help="the triangles-against-error points")
     parser.add_argument("--plot", type=Path, help="PNG of triangles against error (needs matplotlib)")
@@ -226,6 +283,17 @@ def main(argv=None) -> int:
     print(f"device: {tessellator.device.name.strip()}")
     started = time.perf_counter()
     cups, cup = teacups()
+    if args.levels:
+        print(cups.name, cups.num_patches, "patches; error on one teacup")
+        rows = level_rows(tessellator, cups, cup, LEVEL_EPS["teacups"], args.repeat, None)
+        if args.big:
+            big = bigguy_copies(args.big)
+            print(big.name, big.num_patches, "patches")
+            rows += level_rows(tessellator, big, big, LEVEL_EPS["bigguy"], args.repeat, args.error_triangles)
+        if args.json:
+            args.json.write_text(json.dumps({"device": tessellator.device.name.strip(), "levels": rows}, indent=1))
+        print(f"wall {time.perf_counter() - started:.0f} s")
+        return 0
     print("evaluators, 13 x 13 points per patch, Teacups' 2,600 patches (best of --repeat, kernel only):")
     timings = evaluators(tessellator, cups.patches, 12, args.repeat)
     if args.evaluators_only:

@@ -117,8 +117,9 @@ class Tessellation(IndexedMesh):
                 (``device``) has no "read_back" until its arrays are fetched, and "total" then
                 is "stages" + "read_back" (the time the caller spent between is not counted).
     device:     the output on the device (:class:`DeviceOutput`), or None (host arrays only).
-    strips:     (S,) uint32 triangle strips of the strip patterns' patches (SD-2), restart-
+    strips:     (S,) uint32 triangle strips of the strip patterns' patches (SD-2, ESC), restart-
                 separated (cltess.strips), or None; they expand to those patches' triangles
+                (ESC's with their zero-area steps dropped: expand_strips(..., drop_degenerate=True))
     real_factors: (P, 4) float32 real edge factors where a pattern is fractional (SD-2; there
                 ``factors`` are each edge's segments, the odd ceiling), else None
     """

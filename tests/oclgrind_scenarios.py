@@ -310,6 +310,13 @@ def esc_collapsed_lid_screen():
     return scene, dict(pixels=1.0, pattern="esc", max_level=2)
 
 
+def esc_levels_strips():
+    """ESC with per-patch levels (L_p 1 and 3 side by side, the lid's pole patches at the full
+    level) and its strips from the device: stage 1's level choice, strip_counts and
+    strip_indices with patterns/esc.h pattern_strips."""
+    return teapot([0, 4, 8, 12, 16, 20, 21, 24]), dict(eps=0.1, pattern="esc")
+
+
 SCENARIOS = {
     "uniform": uniform,
     "one_transition": one_transition,
@@ -339,6 +346,16 @@ SCENARIOS = {
 
     "esc": esc,
     "esc_collapsed_lid_screen": esc_collapsed_lid_screen,
+    "esc_levels_strips": esc_levels_strips,
+}
+
+#: Scenarios whose normals the default device (Intel's CPU runtime) gets wrong, and why: their
+#: meshes are compared with the simulator's without the normals there (test_results_match_pocl).
+NORMALS_WRONG_ON_INTEL_CPU = {
+    "esc_levels_strips":
+        "Intel's CPU runtime gives ESC's stage 4 wrong normals in vector lanes 1-3 (every patch p with "
+        "p % 4 != 0 of a multi-patch scene; main at 0d4ca32 too; right with CL_CONFIG_USE_VECTORIZER=False, "
+        "on PoCL and in Oclgrind): not traced (notes/issue14.md).",
 }
 
 #: Scenarios whose tessellation is then measured on the device (Tessellator.verify,
@@ -347,7 +364,7 @@ VERIFIED = ("rational_sphere", "pn_icosphere", "mixed_culled")
 
 #: Scenarios run through Tessellator.tessellate_in_batches (if the pipeline has it) with this
 #: output cap in bytes, so stages 4-5 run on sub-ranges of the patches.
-BATCHED = {"many_patches_batched": ("many_patches", 4096)}
+BATCHED = {"many_patches_batched": ("many_patches", 4096), "esc_levels_strips_batched": ("esc_levels_strips", 8192)}
 
 #: Scenarios whose stages 4-5 run by level (Request.emit "by_level", cltess/backends/opencl/levels.py),
 #: whole or (base, output cap in bytes) in batches (the queues and outputs of patch sub-ranges).

@@ -125,6 +125,20 @@ def _fractional_output(plan, first: int, last: int):
     return factors, real, strips[:-1] if len(strips) else strips
 
 
+def _strip_output(plan, first: int, last: int) -> np.ndarray:
+    """The strips of patches first..last-1 of a strip pattern with integer factors (ESC), as the
+    OpenCL backend emits them (strips.emit_strips): global numbers, the last restart dropped."""
+    from ..strips import STRIP_RESTART
+
+    strips = []
+    for _, pattern, base, count, _ in plan.parts:
+        for p in range(max(first, base), min(last, base + count)) if pattern.strips else ():
+            local = pattern.strips(plan.factors[p])
+            strips.append(np.where(local == STRIP_RESTART, local, local + plan.vertex_offsets[p]))
+    strips = np.concatenate(strips).astype(np.uint32) if strips else np.zeros(0, np.uint32)
+    return strips[:-1] if len(strips) else strips
+
+
 class NumpyBackend:
     """``plan(scene, request)`` and ``emit(plan, first, last)`` in NumPy (cltess.backends.base)."""
 
@@ -147,7 +161,7 @@ class NumpyBackend:
             if pattern.dyadic:  # stage 1's rounding (common.h dyadic_factors)
                 f, fl = dyadic_stage(f, fl, request.max_level)
             if pattern.stage1:  # the pattern's own stage 1 (ESC: candidate masks)
-                f, fl = pattern.stage1[1](controls, request.tolerance_for(scene), request.max_level)
+                f, fl = pattern.stage1[1](controls, request.tolerance_for(scene), request.max_level, request.max_factor)
             if pattern.fixed_point:  # a level function's fixed-point factors (SD-2)
                 from ..levels import reference_level_factors
                 f, level_stats = reference_level_factors(scene, request, f)
@@ -193,6 +207,8 @@ class NumpyBackend:
         factors, real_factors, strips = plan.factors[first:last], None, None
         if any(pattern.fixed_point for _, pattern, _, _, _ in plan.parts):
             factors, real_factors, strips = _fractional_output(plan, first, last)
+        elif any(pattern.strips for _, pattern, _, _, _ in plan.parts):  # ESC's strips
+            strips = _strip_output(plan, first, last)
         return Tessellation(triangles=triangles.reshape(-1, 3), factors=factors, strips=strips,
                             real_factors=real_factors,
                             stage_ms={"total_wall": (time.perf_counter() - started) * 1e3},

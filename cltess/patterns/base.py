@@ -27,8 +27,11 @@ class Pattern:
                function (cltess.levels) rather than by the kinds' integer stage 1.
     stage1:    its own stage 1 instead of the kind's factors, ``(defines, host)``: stage 1 is
                built with these ``-D`` defines (``(("PATTERN_ESC", 1),)``), and ``host(patches,
-               tolerance, max_level) -> (records, flags)`` is its NumPy mirror (ESC: the candidate
+               tolerance, max_level, max_factor) -> (records, flags)`` is its NumPy mirror (ESC: the candidate
                masks; cltess/esc/masks.py).
+    strips:    for a strip pattern (primitive "strips") whose factors are integers, f -> its strips
+               as the device emits them (local numbers, each strip followed by STRIP_RESTART;
+               ESC: esc.strip_indices); the NumPy backend's Tessellation.strips.
     layout:    the NumPy mirror, f -> (uv (V, 2) float64, triangles (T, 3) int64 local indices):
                the ring first, then the interior rows, as the device lays the vertices out.
     """
@@ -44,6 +47,7 @@ class Pattern:
     dyadic: bool = False
     fixed_point: bool = False
     stage1: tuple = ()
+    strips: Callable | None = None
 
     @property
     def defines(self) -> dict:

@@ -46,7 +46,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..strips import join_strips
+from ..strips import STRIP_RESTART, join_strips
 from .base import Pattern
 
 #: --max-level default for ESC (Table 1: "Lmax = 3 (16 x 18 triangles per surface)").
@@ -333,10 +333,29 @@ def strips(f) -> np.ndarray:
     return patch_mesh(level, masks, collapsed)[2]
 
 
-def _stage1(patches, tolerance, max_level):
+def strip_indices(f) -> np.ndarray:
+    """The record's strips as the device emits them (kernels/patterns/esc.h pattern_strips): local
+    numbers, each strip followed by one restart marker (so patches concatenate; the host drops the
+    last marker), int64."""
+    local = strips(f).astype(np.int64)
+    return np.append(local, np.int64(STRIP_RESTART)) if len(local) else local
+
+
+def _stage1(patches, tolerance, max_level, max_factor):
     from ..esc.masks import esc_stage  # noqa: PLC0415 (esc.masks imports this module)
-    return esc_stage(patches, tolerance, max_level)
+    return esc_stage(patches, tolerance, max_level, max_factor)
 
 
-ESC = Pattern("esc", "quad", 4, "patterns/esc.h", layout, crack="crack/or_masks.h",
-              stage1=((("PATTERN_ESC", 1),), _stage1))
+def _stage1_one_level(patches, tolerance, max_level, max_factor):
+    from ..esc.masks import esc_stage  # noqa: PLC0415
+    return esc_stage(patches, tolerance, max_level, max_factor, levels=np.full(len(patches), min(max_level, MAX_LEVEL)))
+
+
+ESC = Pattern("esc", "quad", 4, "patterns/esc.h", layout, crack="crack/or_masks.h", primitive="strips",
+              stage1=((("PATTERN_ESC", 1),), _stage1), strips=strip_indices)
+
+#: ESC with one level per run (every patch at L = max level, as before per-patch levels): not in
+#: the registry; bench/esc.py adds it to PATTERNS to measure what per-patch levels change.
+ESC_ONE_LEVEL = Pattern("esc_one_level", "quad", 4, "patterns/esc.h", layout, crack="crack/or_masks.h",
+                        primitive="strips", stage1=((("PATTERN_ESC", 1), ("ESC_ONE_LEVEL", 1)), _stage1_one_level),
+                        strips=strip_indices)

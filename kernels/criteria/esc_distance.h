@@ -5,6 +5,10 @@
  * boundary curve alone (boundary_point on its 4 controls), in its canonical direction (decision
  * 2), so both patches at an edge decide identically; interior ones by NBM-Horner
  * (kinds/bezier_nbm.h).  Writes the record of patterns/esc.h.  Mirror: cltess/esc/masks.py.
+ * Per-patch level (decision 5): the record keeps the lattice of L = max_level, and a patch tests
+ * only the candidates of its own level L_p, the coarsest level whose candidates lie on that
+ * lattice and whose 3 (L_p + 1) segments per side meet the Zheng-Sederberg factor of the patch
+ * (kinds/bezier.h kind_factors, in object space or pixels); the others stay 0.
  * Needs kinds/bezier.h (included before it by stages/factors.cl). */
 #ifndef CLTESS_CRITERIA_ESC_DISTANCE_H
 #define CLTESS_CRITERIA_ESC_DISTANCE_H
@@ -26,11 +30,28 @@ inline int esc_edge_reversed(__private const float4 c[4])
     return 0;  /* a palindrome: either direction gives the same points */
 }
 
-/* L bits of a coarse edge from its surface points: ends p0, p1, candidates at k/n. */
-inline uint esc_chord_bits(float3 p0, float3 p1, __private const float3 candidate[ESC_MAX_LEVEL], int level, float eps)
+/* Steps per coarse edge of a patch whose bound asks for `factor` segments per side: the fewest d
+ * dividing n = L + 1 (the record's lattice; docs/esc.md decision 5) with 3 d >= factor, else n.
+ * Its candidates are those k / n with k d a multiple of n (esc_candidate_tested). */
+inline int esc_patch_steps(int factor, int n)
+{
+    for (int d = 1; d < n; ++d)
+        if (n % d == 0 && 3 * d >= factor)
+            return d;
+    return n;
+}
+
+inline int esc_candidate_tested(int k, int steps, int n) { return (k * steps) % n == 0; }
+
+/* L bits of a coarse edge from its surface points: ends p0, p1, candidates at k/n; only those of
+ * the patch's level (steps per coarse edge) are tested, the others stay 0. */
+inline uint esc_chord_bits(float3 p0, float3 p1, __private const float3 candidate[ESC_MAX_LEVEL], int level,
+                           int steps, float eps)
 {
     uint bits = 0;
     for (int k = 1; k <= level; ++k) {
+        if (!esc_candidate_tested(k, steps, level + 1))
+            continue;
         float w1 = (float)k / (float)(level + 1), w0 = (float)(level + 1 - k) / (float)(level + 1);
         float3 chord = p0 * w0 + p1 * w1;  /* commutative per component: the same bits both ways */
         if (length(candidate[k - 1] - chord) > eps)
@@ -39,18 +60,33 @@ inline uint esc_chord_bits(float3 p0, float3 p1, __private const float3 candidat
     return bits;
 }
 
-inline int4 esc_factors(__global const float4 *source, uint p, tolerance_args tol, int max_level, int *flags)
+/* source: the Bezier kind's bound constants (kind_factors), controls: the patches. */
+inline int4 esc_factors(__global float4 *source, __global float4 *controls, uint p, tolerance_args tol,
+                        int max_factor, int max_level, int *flags)
 {
+    int4 bound = kind_factors(source, controls, p, tol, max_factor, flags);
+    if (*flags & FLAG_CULLED)
+        return (int4)(0);
     float4 b[16];
-    load_patch(source, p, b);
+    load_patch(controls, p, b);
     int culled;
     float eps = bezier_tolerance(b, tol, &culled);
-    if (culled) {
-        *flags = FLAG_CULLED;
-        return (int4)(0);
+    int level = clamp(max_level, 0, ESC_MAX_LEVEL), n = level + 1, m = 3 * n;  /* levels above 3: capped */
+    int factor = max(bound.s0, bound.s1), steps = esc_patch_steps(factor, n);
+    for (int e = 0; e < 4; ++e) {  /* a pole (a boundary curve that is one point): the full level */
+        float4 c[4];
+        edge_controls(b, e, c);
+        int point = 1;  /* c_k.xyz / c_k.w all equal, compared by (correctly rounded) products */
+        for (int k = 1; k < 4; ++k)
+            point &= all(c[k].xyz * c[0].w == c[0].xyz * c[k].w);
+        if (point)
+            steps = n;
     }
-    int level = clamp(max_level, 0, ESC_MAX_LEVEL), n = level + 1, m = 3 * n;
-    *flags = 0;  /* levels above 3 are capped (docs/esc.md): no bound to saturate */
+#ifdef ESC_ONE_LEVEL
+    steps = n;  /* one level per run, every patch at L (esc.py ESC_ONE_LEVEL: bench/esc.py's baseline) */
+#endif
+    /* saturated: the bound asks for more than the lattice has (or than max_factor) */
+    *flags = (*flags & FLAG_SATURATED) | (factor > m ? FLAG_SATURATED : 0);
     int slots[4];
     /* the boundary: each patch edge's 3 coarse edges from its curve, canonical direction */
     for (int e = 0; e < 4; ++e) {
@@ -69,7 +105,7 @@ inline int4 esc_factors(__global const float4 *source, uint p, tolerance_args to
                 float4 h = boundary_point(canonical, t);
                 candidate[k - 1] = h.xyz / h.w;
             }
-            bits |= esc_chord_bits(h0.xyz / h0.w, h1.xyz / h1.w, candidate, level, eps) << (s * level);
+            bits |= esc_chord_bits(h0.xyz / h0.w, h1.xyz / h1.w, candidate, level, steps, eps) << (s * level);
         }
         slots[e] = (int)bits | (reversed ? ESC_REVERSED : 0);
     }
@@ -101,7 +137,7 @@ inline int4 esc_factors(__global const float4 *source, uint p, tolerance_args to
             int2 x = n * start + k * (end - start);
             candidate[k - 1] = nbm_position(nbm, (float)x.x / (float)m, (float)x.y / (float)m);
         }
-        interior |= (ulong)esc_chord_bits(p0, p1, candidate, level, eps) << (slot * level);
+        interior |= (ulong)esc_chord_bits(p0, p1, candidate, level, steps, eps) << (slot * level);
         ++slot;
     }
     int4 f;

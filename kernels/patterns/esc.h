@@ -301,21 +301,67 @@ inline int2 esc_lattice(__private const int2 corner[3], int n, int2 p)
     return n * corner[0] + (p.x - p.y) * (corner[1] - corner[0]) + p.y * (corner[2] - corner[0]);
 }
 
-inline uint esc_triangle(__private const esc_patch *g, __private const int2 corner[3], int2 a, int2 b, int2 c,
-                         __global uint *out, uint *count, uint base)
+/* Where the walk writes (one walk, four modes): triangles (stage 5 list) or strips (each followed
+ * by STRIP_RESTART, cltess/strips.py), counted either way; null pointers: count only. */
+typedef struct {
+    __global uint *triangles, *strips;
+    uint base, triangle_count, strip_count;
+    int strip_mode;                      /* walk for strips (else for triangles) */
+    int2 strip[2 * ESC_MAX_LEVEL + 12];  /* the band's strip (esc.py coarse_triangle), its points */
+    int length, band_triangles;
+} esc_writer;
+
+inline void esc_triangle(__private const esc_patch *g, __private const int2 corner[3], int2 a, int2 b, int2 c,
+                         __private esc_writer *w)
 {
     if ((a.x == b.x && a.y == b.y) || (b.x == c.x && b.y == c.y) || (a.x == c.x && a.y == c.y))
-        return 0;
+        return;
+    ++w->band_triangles;  /* a triangle of the band (rule 3 dropped the repeated points) */
+    if (w->strip_mode)
+        return;
     uint ia = esc_index(g, esc_lattice(corner, g->r.n, a)), ib = esc_index(g, esc_lattice(corner, g->r.n, b));
     uint ic = esc_index(g, esc_lattice(corner, g->r.n, c));
     if (ia == ib || ib == ic || ia == ic)
-        return 0;  /* a side on a collapsed edge */
-    put_triangle(out, count, base, ia, ib, ic);
-    return 1;
+        return;  /* a side on a collapsed edge */
+    put_triangle(w->triangles, &w->triangle_count, w->base, ia, ib, ic);
 }
 
-/* The zipper of esc.py coarse_triangle over the bands between consecutive active rows. */
-inline void esc_coarse_triangle(__private const esc_patch *g, int t, __global uint *out, uint *count, uint base)
+inline void esc_strip_put(__private esc_writer *w, int2 p)
+{
+    if (w->strip_mode)
+        w->strip[w->length++] = p;
+}
+
+inline int esc_same(int2 a, int2 b) { return a.x == b.x && a.y == b.y; }
+
+/* The band's strip, once the band is done: trailing zero-area steps trimmed, written (local
+ * vertex numbers + base, then STRIP_RESTART) when the band has a triangle. */
+inline void esc_strip_end(__private const esc_patch *g, __private const int2 corner[3], __private esc_writer *w)
+{
+    if (!w->strip_mode)
+        return;
+    while (w->length >= 3) {
+        int2 a = w->strip[w->length - 3], b = w->strip[w->length - 2], c = w->strip[w->length - 1];
+        if (!(esc_same(a, b) || esc_same(b, c) || esc_same(a, c)))
+            break;
+        --w->length;
+    }
+    if (w->band_triangles) {
+        for (int k = 0; k < w->length; ++k) {
+            if (w->strips)
+                w->strips[w->strip_count] = w->base + esc_index(g, esc_lattice(corner, g->r.n, w->strip[k]));
+            ++w->strip_count;
+        }
+        if (w->strips)
+            w->strips[w->strip_count] = STRIP_RESTART;
+        ++w->strip_count;
+    }
+}
+
+/* The zipper of esc.py coarse_triangle over the bands between consecutive active rows: each
+ * step a triangle (lower, upper, next) and, in strip mode, its strip point(s) (rule 4: a copy
+ * of the other side's point where one side advances twice; lower points at even positions). */
+inline void esc_coarse_triangle(__private const esc_patch *g, int t, __private esc_writer *w)
 {
     int2 corner[3], upper[ESC_MAX_LEVEL + 3], lower[ESC_MAX_LEVEL + 3];  /* chains, right to left */
     uint bits[3];
@@ -328,11 +374,15 @@ inline void esc_coarse_triangle(__private const esc_patch *g, int t, __global ui
         int lower_length = esc_chain_length(bits, b, n);
         for (int k = 0; k < lower_length; ++k)
             lower[k] = esc_chain_point(bits, b, k, n);
-        int u = upper[0].x != a ? 1 : 0, w = 0;  /* a virtual right end: the lower chain's start */
-        while (u < upper_length - 1 || w < lower_length - 1) {
+        int u = upper[0].x != a ? 1 : 0, v = 0;  /* a virtual right end: the lower chain's start */
+        w->length = 0;
+        w->band_triangles = 0;
+        esc_strip_put(w, lower[0]);
+        esc_strip_put(w, upper[u]);
+        while (u < upper_length - 1 || v < lower_length - 1) {
             int advance_upper;
-            int2 next_upper = upper[min(u + 1, upper_length - 1)], next_lower = lower[min(w + 1, lower_length - 1)];
-            if (w == lower_length - 1) {
+            int2 next_upper = upper[min(u + 1, upper_length - 1)], next_lower = lower[min(v + 1, lower_length - 1)];
+            if (v == lower_length - 1) {
                 advance_upper = 1;
             } else if (u == upper_length - 1) {
                 advance_upper = 0;
@@ -341,12 +391,20 @@ inline void esc_coarse_triangle(__private const esc_patch *g, int t, __global ui
                 int along_lower = (next_lower.x - next_lower.y) * next_upper.x;
                 advance_upper = along_upper != along_lower ? along_upper < along_lower : next_upper.x < next_lower.x;
             }
-            esc_triangle(g, corner, lower[w], upper[u], advance_upper ? next_upper : next_lower, out, count, base);
-            if (advance_upper)
+            esc_triangle(g, corner, lower[v], upper[u], advance_upper ? next_upper : next_lower, w);
+            if (advance_upper) {
                 ++u;
-            else
-                ++w;
+                if (!(w->length & 1))  /* upper points at odd positions: copy the lower one */
+                    esc_strip_put(w, lower[v]);
+                esc_strip_put(w, upper[u]);
+            } else {
+                ++v;
+                if (w->length & 1)
+                    esc_strip_put(w, upper[u]);
+                esc_strip_put(w, lower[v]);
+            }
         }
+        esc_strip_end(g, corner, w);
         for (int k = 0; k < lower_length; ++k)  /* the lower chain is the next band's upper one */
             upper[k] = lower[k];
         upper_length = lower_length;
@@ -371,16 +429,43 @@ inline void esc_setup(int4 f, int collapsed, __private esc_patch *g)
     }
 }
 
-inline uint pattern_primitives(int4 f, int collapsed, __global uint *out, uint base)
+/* The walk over the 18 coarse triangles, in either mode. */
+inline void esc_walk(int4 f, int collapsed, __private esc_writer *w)
 {
     if (f.s0 <= 0)
-        return 0;
+        return;
     esc_patch g;
     esc_setup(f, collapsed, &g);
-    uint count = 0;
     for (int t = 0; t < 18; ++t)
-        esc_coarse_triangle(&g, t, out, &count, base);
-    return count;
+        esc_coarse_triangle(&g, t, w);
+}
+
+/* Triangles ("count" mode when out == 0, "emit" otherwise). */
+inline uint pattern_primitives(int4 f, int collapsed, __global uint *out, uint base)
+{
+    esc_writer w;
+    w.triangles = out;
+    w.strips = 0;
+    w.base = base;
+    w.triangle_count = w.strip_count = 0;
+    w.strip_mode = 0;
+    esc_walk(f, collapsed, &w);
+    return w.triangle_count;
+}
+
+/* Strip indices, each strip followed by STRIP_RESTART (count mode when out == 0): one strip per
+ * band of a coarse triangle, esc.py patch_mesh's strips in its order (stages/strip_counts.cl,
+ * strip_indices.cl; cltess/backends/opencl/strips.py). */
+inline uint pattern_strips(int4 f, int collapsed, __global uint *out, uint base)
+{
+    esc_writer w;
+    w.triangles = 0;
+    w.strips = out;
+    w.base = base;
+    w.triangle_count = w.strip_count = 0;
+    w.strip_mode = 1;
+    esc_walk(f, collapsed, &w);
+    return w.strip_count;
 }
 
 #endif

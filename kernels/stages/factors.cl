@@ -23,7 +23,7 @@ __kernel void factors(__global float4 *source, __global float4 *controls, uint n
     tolerance_args tol = {eps, view, frustum, pixels, pixel_size};
     int flag = 0;
 #ifdef PATTERN_ESC
-    int4 f = esc_factors(controls, p, tol, max_level, &flag);  /* the patches (source: the bound constants) */
+    int4 f = esc_factors(source, controls, p, tol, max_factor, max_level, &flag);  /* masks; L_p from the bound */
 #else
     int4 f = kind_factors(source, controls, p, tol, max_factor, &flag);
 #endif

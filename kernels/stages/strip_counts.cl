@@ -1,4 +1,4 @@
-/* Stage 3 for strip output (a pattern with pattern_strips, patterns/sd2.h): per-patch strip
+/* Stage 3 for strip output (a pattern with pattern_strips: patterns/sd2.h, esc.h): per-patch strip
  * index counts (restart markers included), the pattern's strips in "count" mode, the same walk
  * stages/strip_indices.cl runs in "emit" mode.  One work-item per patch. */
 __kernel void strip_counts(__global const int4 *factors, uint num_patches, uint patch_base,

@@ -1,5 +1,5 @@
 """Triangle-strip output on the device, for the patches of a strip pattern (``Pattern.primitive
-== "strips"``: SD-2), beside the triangle list (cltess/strips.py has the one convention: uint32
+== "strips"``: SD-2, ESC), beside the triangle list (cltess/strips.py has the one convention: uint32
 indices, each strip followed by STRIP_RESTART on the device, the array's last marker dropped).
 
     stage 3  stages/strip_counts.cl   per-patch strip index counts, the pattern's strip walk in
