@@ -92,7 +92,7 @@ def tolerances_below_float32(scene, eps: float | None = None, pixels: float | No
     ``--pixels`` the tolerance shrinks with the depth, so the scene-wide eps check
     (limits.eps_below_float32) does not apply; far from the origin a fine pixel tolerance can ask
     for less than float32 can hold."""
-    from .criteria.tolerance import box_tolerances
+    from .criteria.tolerance import FLOAT32_TOLERANCE_STEPS, box_tolerances, float32_tolerance_floor
     from .limits import EPS_FLOAT32_STEPS
 
     boxes = []
@@ -113,10 +113,13 @@ def tolerances_below_float32(scene, eps: float | None = None, pixels: float | No
         return None
     worst = below[np.argmin(tolerance[below] / floor[below])]
     asked = f"--pixels {pixels:g}" if pixels is not None else f"eps {eps:g}"
+    raised = np.count_nonzero(tolerance[below] <= float32_tolerance_floor(lo[below], hi[below]))
+    raised = (f"; {raised} of them get {FLOAT32_TOLERANCE_STEPS:g} float32 steps instead of a finer tolerance"
+              if raised else "")
     return (f"{asked} gives {len(below)} patch(es) a tolerance below {EPS_FLOAT32_STEPS} float32 steps where they "
             f"lie (patch {worst}: {tolerance[worst]:.3g}, below {floor[worst]:.3g} at its coordinate "
             f"{largest[worst]:.6g}): the output's float32 coordinates cannot resolve it, so the error bound may "
-            "not hold there; move the scene nearer the origin or raise the tolerance")
+            f"not hold there{raised}; move the scene nearer the origin or raise the tolerance")
 
 
 __all__ = ["scene_tolerances", "tolerances_below_float32", "worst_bound_ratio"]

@@ -160,6 +160,11 @@ def eps_below_float32(scene, eps: float) -> str | None:
     step = float(np.spacing(np.float32(largest)))
     if eps >= EPS_FLOAT32_STEPS * step:
         return None
+    from .criteria.tolerance import FLOAT32_TOLERANCE_STEPS
+
+    raised = (f"; patches whose tolerance would be below {FLOAT32_TOLERANCE_STEPS:g} float32 steps where they lie "
+              f"get that instead (up to {FLOAT32_TOLERANCE_STEPS * step:.3g} here)"
+              if eps < FLOAT32_TOLERANCE_STEPS * step else "")
     return (f"eps {eps:g} is below {EPS_FLOAT32_STEPS} float32 steps ({EPS_FLOAT32_STEPS * step:.3g}) at the "
             f"scene's largest coordinate, {largest:.6g}: the output's float32 coordinates cannot resolve it, "
-            "so the error bound may not hold; move the scene nearer the origin or raise eps")
+            f"so the error bound may not hold{raised}; move the scene nearer the origin or raise eps")

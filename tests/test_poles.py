@@ -49,7 +49,12 @@ def assert_clean(tess, closed=True):
 @pytest.mark.parametrize("fd", [True, False], ids=["fd", "direct"])
 @pytest.mark.parametrize("name, offset, relative_eps", [
     ("sphere.bpt", 0, 1e-2), ("sphere.bpt", 0, 1e-3), ("sphere.bpt", 1e3, 1e-3), ("sphere.bpt", 1e5, 1e-2),
-    ("torus.bpt", 0, 1e-3), ("torus.bpt", 1e3, 1e-3), ("torus.bpt", 1e5, 1e-2)])
+    ("torus.bpt", 0, 1e-3), ("torus.bpt", 1e3, 1e-3), ("torus.bpt", 1e5, 1e-2),
+    # eps below one float32 step at 1e5 (0.44 and 0.04 steps on the sphere): the tolerance is
+    # raised to criteria.tolerance.FLOAT32_TOLERANCE_STEPS there (the sphere welded with 4 and
+    # 2,302 degenerate triangles before); 1e6 with 2 steps still clean
+    ("sphere.bpt", 1e5, 1e-3), ("sphere.bpt", 1e5, 1e-4), ("torus.bpt", 1e5, 1e-4),
+    ("sphere.bpt", 1e6, 1e-4), ("torus.bpt", 1e6, 1e-4)])
 def test_closed_rational_scenes_weld_to_closed_manifolds(tessellator, name, offset, relative_eps, fd):
     scene, diagonal = translated_scene(SCENES / name, offset)
     tess = tessellator.tessellate(scene, eps=relative_eps * diagonal, forward_differencing=fd)
@@ -131,3 +136,24 @@ def test_exact_corners_project_to_their_float32_points(rng):
     assert hits.mean() > 0.99
     assert np.abs(exact[:, 3] / homogeneous[:, 3] - 1).max() < 3e-6  # weights barely move
     assert np.array_equal(exact_corners(homogeneous, points.astype(np.float32)), exact)  # deterministic
+
+
+def test_the_cli_raises_a_tolerance_below_float32_steps_says_so_and_welds_clean(capsys, tmp_path):
+    """Issue 9: the sphere moved by 1e5 with eps 0.001 (0.13 float32 steps there) gets 2 steps
+    per patch instead (criteria.tolerance.FLOAT32_TOLERANCE_STEPS), the warning before the run
+    says so, and the written mesh welds closed with no degenerate triangle."""
+    import json
+    from types import SimpleNamespace
+
+    from cltess.cli import main
+
+    scene = tmp_path / "far.json"
+    scene.write_text(json.dumps({"objects": [{"file": str(SCENES / "sphere.bpt"), "transform": [
+        [1, 0, 0, 1e5], [0, 1, 0, 1e5], [0, 0, 1, 1e5], [0, 0, 0, 1]]}]}))
+    out = tmp_path / "far.npz"
+    assert main(["tessellate", str(scene), "--eps", "0.001", "-q", "-o", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert f"cltess: warning: {scene}: eps 0.001 is below 16 float32 steps" in err
+    assert "get that instead (up to 0.0156 here)" in err
+    with np.load(out) as mesh:
+        assert_clean(SimpleNamespace(positions=mesh["positions"], triangles=mesh["triangles"]))

@@ -371,11 +371,14 @@ def test_device_counts_at_the_largest_factor_are_exact(tessellator, kind):
 
 
 def curved_patches_bpt(path: Path, count: int) -> Path:
-    """``count`` strongly curved, separate patches: at eps 1e-20 every one saturates."""
+    """``count`` strongly curved, separate patches: at eps 1e-20 every one saturates.  The weight
+    100 on one inner point keeps them saturating at the tolerance floor of 2 float32 steps
+    (criteria.tolerance.FLOAT32_TOLERANCE_STEPS): 1/du ~ 87,000 there, 4,000 with equal weights."""
     lines = [str(count)]
     for p in range(count):
         lines.append("3 3")
-        lines += [f"{i + 10 * p} {j} {(i - 1.5) ** 2 * (j - 1.5) ** 2}" for j in range(4) for i in range(4)]
+        lines += [f"{i + 10 * p} {j} {(i - 1.5) ** 2 * (j - 1.5) ** 2} {100.0 if (i, j) == (1, 1) else 1.0}"
+                  for j in range(4) for i in range(4)]
     path.write_text("\n".join(lines) + "\n")
     return path
 

@@ -11,6 +11,21 @@ import numpy as np
 
 from ..scene import Camera
 
+#: No patch gets a tolerance below this many float32 steps (ulps) at its largest coordinate
+#: (kernels/criteria/tolerance.h FLOAT32_TOLERANCE_STEPS, checked equal by
+#: tests/contracts/test_constants.py; docs/design.md section 7): the output's float32 coordinates
+#: cannot hold a finer one, and below about one step neighbouring vertices round to one point
+#: (the sphere translated by 1e5 welded with degenerate triangles and non-manifold edges at 0.45
+#: steps, cleanly from 0.9; 2 keeps the translated sphere and torus clean up to 1e6).
+FLOAT32_TOLERANCE_STEPS = 2.0
+
+
+def float32_tolerance_floor(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """(P,) float64: FLOAT32_TOLERANCE_STEPS float32 steps at the largest |coordinate| of each
+    box lo, hi (P, 3), as kernels/criteria/tolerance.h float32_tolerance_floor computes it."""
+    largest = np.maximum(np.abs(lo), np.abs(hi)).max(axis=1).astype(np.float32)
+    return FLOAT32_TOLERANCE_STEPS * np.spacing(largest).astype(np.float64)
+
 
 @dataclass(frozen=True)
 class ObjectSpace:
@@ -61,10 +76,12 @@ def patch_tolerances(patches: np.ndarray, eps: float | None = None, pixels: floa
 
 def box_tolerances(lo: np.ndarray, hi: np.ndarray, eps: float | None = None, pixels: float | None = None,
                    camera: Camera | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """patch_tolerances for patches given by their bounding boxes lo, hi (P, 3)."""
+    """patch_tolerances for patches given by their bounding boxes lo, hi (P, 3); either
+    tolerance is raised to float32_tolerance_floor(lo, hi) where it is below."""
     count = len(lo)
+    floor = float32_tolerance_floor(lo, hi)
     if pixels is None:
-        return np.full(count, float(eps)), np.zeros(count, bool)
+        return np.maximum(np.full(count, float(eps)), floor), np.zeros(count, bool)
     corners = np.stack([np.where([(c >> a) & 1 for a in range(3)], hi, lo) for c in range(8)], axis=1)
     view = camera.view_matrix()
     cam = corners @ view[:3, :3].T + view[:3, 3]  # (P, 8, 3)
@@ -76,7 +93,7 @@ def box_tolerances(lo: np.ndarray, hi: np.ndarray, eps: float | None = None, pix
                cam[..., 1] > tan_y * depth, cam[..., 1] < -tan_y * depth]
     culled = np.any([o.all(axis=1) for o in outside], axis=0)
     nearest = np.maximum(depth.min(axis=1), camera.near)
-    return pixels * nearest * camera.pixel_size_at_unit_depth(), culled
+    return np.maximum(pixels * nearest * camera.pixel_size_at_unit_depth(), floor), culled
 
 
 def camera_arguments(camera: Camera | None):

@@ -16,14 +16,30 @@ typedef struct {
     float pixel_size;
 } tolerance_args;
 
+/* No patch gets a tolerance below this many float32 steps at its largest coordinate
+ * (cltess.criteria.tolerance.FLOAT32_TOLERANCE_STEPS; docs/design.md section 7): the output's
+ * float32 coordinates cannot hold a finer one, and below about one step neighbouring vertices
+ * round to one point (degenerate, non-manifold welds far from the origin). */
+#define FLOAT32_TOLERANCE_STEPS 2.0f
+
+/* FLOAT32_TOLERANCE_STEPS float32 steps (ulps) at the largest |coordinate| of the box lo..hi. */
+inline float float32_tolerance_floor(float3 lo, float3 hi)
+{
+    float3 extent = max(fabs(lo), fabs(hi));
+    float largest = max(max(extent.x, extent.y), extent.z);
+    return FLOAT32_TOLERANCE_STEPS * (nextafter(largest, INFINITY) - largest);
+}
+
 /* Object-space tolerance of the patch whose control points lie in the box lo..hi, and whether
  * it is culled.  Object space: every patch gets eps.  Screen space: eps = pixels * nearest
- * depth * pixel_size, and a box entirely outside one frustum plane is culled. */
+ * depth * pixel_size, and a box entirely outside one frustum plane is culled.  Either is raised
+ * to float32_tolerance_floor(lo, hi) where it is below. */
 inline float patch_tolerance(float3 lo, float3 hi, tolerance_args tol, int *culled)
 {
     *culled = 0;
+    float floor = float32_tolerance_floor(lo, hi);
 #ifndef TOLERANCE_SCREEN
-    return tol.eps;
+    return max(tol.eps, floor);
 #else
     float16 view = tol.view;
     float tan_x = tol.frustum.s0, tan_y = tol.frustum.s1, near = tol.frustum.s2, far = tol.frustum.s3;
@@ -40,7 +56,7 @@ inline float patch_tolerance(float3 lo, float3 hi, tolerance_args tol, int *cull
         nearest = min(nearest, depth);
     }
     *culled = out_mask != 0;
-    return tol.pixels * max(nearest, near) * tol.pixel_size;
+    return max(tol.pixels * max(nearest, near) * tol.pixel_size, floor);
 #endif
 }
 

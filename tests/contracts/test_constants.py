@@ -69,3 +69,10 @@ def test_the_strip_restart_marker_is_shared():
     common = (kernel_dir() / "common.h").read_text()
     value = re.search(r"^#define\s+STRIP_RESTART\s+(0x[0-9A-Fa-f]+)u\b", common, re.MULTILINE).group(1)
     assert int(value, 16) == int(STRIP_RESTART) == 2**32 - 1
+
+
+def test_the_float32_tolerance_floor_equals_the_mirrors():
+    from cltess.criteria import tolerance
+
+    found = defines("criteria/tolerance.h")
+    assert np.float32(found["FLOAT32_TOLERANCE_STEPS"]) == np.float32(tolerance.FLOAT32_TOLERANCE_STEPS)
