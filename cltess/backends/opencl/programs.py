@@ -29,7 +29,9 @@ STAGE_AXES = {
     # stages 4-5 by level (levels.py), for a pattern with a template: built when asked for
     "level_vertices": ("kind", "pattern"),
     "level_indices": ("pattern",),  # two kernels: level_interior, level_band
-    "vertex_rows": ("kind", "pattern"),  # stage 4 a work-item per row (Tessellator(rows_in_parallel=True))
+    "vertex_rows": ("kind", "pattern"),  # stage 4 a work-item per row (Tessellator(work="rows"))
+    "vertex_points": ("kind", "pattern"),  # stage 4 a work-item per vertex (Tessellator(work="point"))
+    "triangles": ("pattern",),  # stage 5 a work-item per triangle (Tessellator(work="point"))
     "verify": ("kind",),  # on request only (Tessellator.verify), so not in STAGES
     # silhouette refinement per frame (silhouette.py; they include criteria/silhouette.h)
     "silhouette_alpha": (),
@@ -43,6 +45,10 @@ STAGE_AXES = {
     "vertex_bounds": ("level",),
     "level_factors": ("level",),
 }
+
+#: The stage 4-5 programs of a work distribution other than a patch per work-item
+#: (tessellator.py WORK_DISTRIBUTIONS).
+WORK_STAGES = {"rows": ("vertex_rows",), "point": ("vertex_points", "triangles")}
 
 
 def kernel_dir() -> Path:
@@ -111,9 +117,10 @@ class Programs:
             self._kernels[key, entry] = getattr(self._programs[key], entry or stage)
         return self._kernels[key, entry]
 
-    def compose(self, kind, pattern, tolerance) -> None:
-        """Build (or find) every stage's program for one (kind, pattern, tolerance) now."""
-        for stage in STAGES:
+    def compose(self, kind, pattern, tolerance, work: str = "patch") -> None:
+        """Build (or find) every stage's program for one (kind, pattern, tolerance) now, and the
+        stage 4-5 kernels of a work distribution (``WORK_STAGES``)."""
+        for stage in STAGES + WORK_STAGES.get(work, ()):
             self.kernel(stage, kind=kind, pattern=pattern, tolerance=tolerance, crack=pattern.crack)
 
     def build(self, stage: str, headers: tuple, defines: dict) -> cl.Program:
