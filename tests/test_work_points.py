@@ -26,6 +26,11 @@ def by_points(tessellator):
     return opencl.Tessellator(tessellator.device, work="point")
 
 
+@pytest.fixture(scope="module")
+def by_vertices(tessellator):
+    return opencl.Tessellator(tessellator.device, work="vertex")
+
+
 def same(expected, got, normals=True):
     assert expected.num_triangles > 0
     for field in HOST_FIELDS:
@@ -33,8 +38,11 @@ def same(expected, got, normals=True):
             assert np.array_equal(getattr(expected, field), getattr(got, field)), field
 
 
+@pytest.mark.parametrize("records_per_item", [1, 3, opencl.RECORDS_PER_ITEM])
 @pytest.mark.parametrize("name, options", CASES)
-def test_points_are_bitwise_the_per_patch_kernels(tessellator, by_points, name, options):
+def test_points_are_bitwise_the_per_patch_kernels(tessellator, by_points, monkeypatch, name, options,
+                                                  records_per_item):
+    monkeypatch.setattr(opencl, "RECORDS_PER_ITEM", records_per_item)
     scene = load_scene(SCENES / name)
     per_patch = opencl.Tessellator(tessellator.device, work="patch")
     expected, got = per_patch.tessellate(scene, **options), by_points.tessellate(scene, **options)
@@ -66,6 +74,14 @@ def test_work_is_checked(tessellator, monkeypatch):
         opencl.Tessellator(tessellator.device, work="warp")
     monkeypatch.setenv("CLTESS_WORK", "point")
     assert opencl.Tessellator(tessellator.device).work == "point"
-    monkeypatch.setenv("CLTESS_WORK", "vertex")
+    monkeypatch.setenv("CLTESS_WORK", "warp")
     with pytest.raises(ValueError, match="CLTESS_WORK"):
         opencl.Tessellator(tessellator.device)
+
+
+@pytest.mark.parametrize("name, options", [("tea_table.json", dict(pixels=0.5)), ("sphere.bpt", dict(eps=1e-3))])
+def test_vertices_alone_are_bitwise_the_per_patch_kernels(tessellator, by_vertices, name, options):
+    """work="vertex": stage 4 a work-item per vertex, stage 5 per patch."""
+    scene = load_scene(SCENES / name)
+    same(opencl.Tessellator(tessellator.device, work="patch").tessellate(scene, **options),
+         by_vertices.tessellate(scene, **options))

@@ -1,30 +1,39 @@
 /* Stage 5 a work-item per output triangle (issue 15, for GPUs): consecutive work-items write
- * consecutive triangles (coalesced stores).  Work-item id owns the batch's triangle id: its
- * patch by binary search over index_offsets (patch_of, common.h), its local number t.
- * A pattern with random access to a regular patch's triangles (PATTERN_TRIANGLE_AT,
- * pattern_triangle_at) gives triangle t directly; any other patch is emitted whole by the
- * work-item of its triangle 0 with pattern_primitives, as stages/indices.cl does.  Either way
- * the bits of stages/indices.cl.  The batch is patches
- * first_patch .. first_patch + num_patches - 1; work-items past its last triangle return. */
+ * consecutive triangles (coalesced stores).  As stages/vertex_points.cl: a work-group of G
+ * work-items owns G * per_item consecutive triangles of the batch, in step k its work-item l
+ * writes triangle k G + l of them, and it finds a triangle's patch by patch_of (common.h) over
+ * index_offsets only when the patch changes.  A pattern with random access to a regular
+ * patch's triangles (PATTERN_TRIANGLE_AT, pattern_triangle_at) gives triangle t directly; any
+ * other patch is emitted whole by the work-item of its triangle 0 with pattern_primitives, as
+ * stages/indices.cl does.  Either way the bits of stages/indices.cl.  The batch is patches
+ * first_patch .. first_patch + num_patches - 1; work-items past its last triangle stop. */
 __kernel void triangles(__global const int4 *factors, __global const ulong *vertex_offsets,
                         __global const ulong *index_offsets, uint first_patch, uint num_patches,
-                        ulong index_base, __global uint *indices)
+                        ulong index_base, uint per_item, __global uint *indices)
 {
     uint last = first_patch + num_patches;
-    ulong at = index_offsets[first_patch] + 3 * (ulong)get_global_id(0);  /* the triangle's first index */
-    if (at >= index_offsets[last])
-        return;
-    uint p = patch_of(index_offsets, first_patch, last, at);
-    int collapsed;
-    int4 f = patch_factors(factors[p], &collapsed);
-    uint t = (uint)((at - index_offsets[p]) / 3), base = (uint)vertex_offsets[p];
+    ulong end = index_offsets[last], group = get_local_size(0);
+    ulong at = index_offsets[first_patch] + 3 * (get_group_id(0) * group * per_item + get_local_id(0));
+    uint p = first_patch, base = 0;
+    ulong patch_end = 0;  /* no patch found yet */
+    int4 f = (int4)(0);
+    int collapsed = 0;
+    for (uint k = 0; k < per_item && at < end; ++k, at += 3 * group) {
+        if (at >= patch_end) {
+            p = patch_of(index_offsets, p, last, at);
+            patch_end = index_offsets[p + 1];
+            f = patch_factors(factors[p], &collapsed);
+            base = (uint)vertex_offsets[p];
+        }
+        uint t = (uint)((at - index_offsets[p]) / 3);
 #ifdef PATTERN_TRIANGLE_AT
-    uint3 triangle;
-    if (pattern_triangle_at(f, collapsed, t, &triangle)) {
-        vstore3(triangle + base, (at - index_base) / 3, indices);
-        return;
-    }
+        uint3 triangle;
+        if (pattern_triangle_at(f, collapsed, t, &triangle)) {
+            vstore3(triangle + base, (at - index_base) / 3, indices);
+            continue;
+        }
 #endif
-    if (t == 0)
-        pattern_primitives(f, collapsed, indices + (index_offsets[p] - index_base), base);
+        if (t == 0)
+            pattern_primitives(f, collapsed, indices + (index_offsets[p] - index_base), base);
+    }
 }

@@ -47,12 +47,17 @@ WORK_GROUP = 64  # global sizes are rounded up to this; kernels guard their inde
 #: stages/vertex_rows.cl: work-items per patch (the ring and 64 rows; a patch with more rows has
 #: its last work-item do the rest, so this is a speed setting, never a limit).
 MAX_ROWS_PER_PATCH = 65
+#: stages/vertex_points.cl and stages/triangles.cl: records per work-item (a work-group of
+#: WORK_GROUP work-items owns WORK_GROUP * this consecutive records, written side by side in
+#: steps; a patch is found and loaded once per work-item and patch, not per record).
+RECORDS_PER_ITEM = 4
 #: How stages 4-5 spread their work (docs/design.md, "Work distribution"): "patch" a work-item
 #: per patch (stages/vertices.cl, stages/indices.cl); "rows" stage 4 a work-item per (patch,
-#: row) (stages/vertex_rows.cl), stage 5 per patch; "point" a work-item per output vertex and per
-#: output triangle (stages/vertex_points.cl, stages/triangles.cl: consecutive work-items write
-#: consecutive records).  All three write the same bits.
-WORK_DISTRIBUTIONS = ("patch", "rows", "point")
+#: row) (stages/vertex_rows.cl), stage 5 per patch; "vertex" stage 4 a work-item per output
+#: vertex (stages/vertex_points.cl), stage 5 per patch; "point" a work-item per output vertex and
+#: per output triangle (stages/vertex_points.cl, stages/triangles.cl: consecutive work-items
+#: write consecutive records).  All write the same bits.
+WORK_DISTRIBUTIONS = ("patch", "rows", "vertex", "point")
 #: The default per device type, chosen by bench/frame_loop.py (bench/RESULTS.md, "Issue 15:
 #: kernels"): CPUs keep a patch per work-item (the point kernels replay forward differencing
 #: per vertex: more arithmetic, which a CPU pays); GPUs a work-item per vertex and triangle.
@@ -61,7 +66,8 @@ DEFAULT_WORK = {"gpu": "point", "other": "patch"}
 
 def default_work(device: cl.Device) -> str:
     """The work distribution for a device: ``CLTESS_WORK`` if set, else ``DEFAULT_WORK``."""
-    chosen = os.environ.get("CLTESS_WORK") or DEFAULT_WORK["gpu" if device.type & cl.device_type.GPU else "other"]
+    gpu = device.type & cl.device_type.GPU and not device.type & cl.device_type.CPU  # Oclgrind says "all"
+    chosen = os.environ.get("CLTESS_WORK") or DEFAULT_WORK["gpu" if gpu else "other"]
     if chosen not in WORK_DISTRIBUTIONS:
         raise ValueError(f"CLTESS_WORK={chosen!r}: expected one of {', '.join(WORK_DISTRIBUTIONS)}")
     return chosen
@@ -93,6 +99,13 @@ def _global_size(n: int) -> tuple[int]:
     return (max(WORK_GROUP, -(-n // WORK_GROUP) * WORK_GROUP),)
 
 
+def _record_groups(records: int) -> tuple[int]:
+    """Global size of the record kernels: WORK_GROUP work-items per RECORDS_PER_ITEM * WORK_GROUP
+    records."""
+    per_group = RECORDS_PER_ITEM * WORK_GROUP
+    return (max(1, -(-records // per_group)) * WORK_GROUP,)
+
+
 def _span_ms(events) -> float:
     """Device milliseconds from the first event's start to the last one's end."""
     return (events[-1].profile.end - events[0].profile.start) * 1e-6
@@ -112,6 +125,7 @@ class Tessellator:
         or "point", bitwise the same output); default per device type (``default_work``).
         rows_in_parallel=True is work="rows" (stages/vertex_rows.cl)."""
         self.device = device if isinstance(device, cl.Device) else pick_device(device)
+        self.one_scan = os.environ.get("CLTESS_ONE_SCAN", "1") != "0"  # stage 3: one scan, else two
         self.work = "rows" if rows_in_parallel else work or default_work(self.device)
         if self.work not in WORK_DISTRIBUTIONS:
             raise ValueError(f"work={self.work!r}: expected one of {', '.join(WORK_DISTRIBUTIONS)}")
@@ -487,10 +501,12 @@ class Tessellator:
         events = [self.programs.kernel("counts", pattern=_pattern(k))(
             self.queue, _global_size(n), None, factors.data, np.uint32(n), np.uint32(base),
             vertex_counts.data, index_counts.data) for k, base, n in ranges if n]
-        # Two scans: one scan of (vertex, index) pairs as ulong2 was misaligned in pyopencl's local
-        # memory, and a segmented one read uninitialised flags (both Oclgrind, issue 15).
-        events += [self.programs.offsets_scan(vertex_counts, vertex_offsets),
-                   self.programs.offsets_scan(index_counts, index_offsets)]
+        if self.one_scan:  # both offsets in one scan of (vertex, index) pairs (programs.py)
+            events.append(self.programs.offsets_pair_scan(vertex_counts, index_counts, vertex_offsets,
+                                                          index_offsets))
+        else:
+            events += [self.programs.offsets_scan(vertex_counts, vertex_offsets),
+                       self.programs.offsets_scan(index_counts, index_offsets)]
         return vertex_offsets, index_offsets, events
 
     def _vertex_arrays(self, n: int) -> dict:
@@ -506,8 +522,8 @@ class Tessellator:
         (V, 3), normals (V, 3), uv (V, 2), patch_ids (V,), object_ids (V,) device arrays,
         V = stop - start (written into ``out`` when given), and the events.  rows_per_patch:
         work-items per patch of stages/vertex_rows.cl (0: one per patch, stages/vertices.cl;
-        None: as ``work``).  work: "patch", "rows" (with ``MAX_ROWS_PER_PATCH``) or "point"
-        (stages/vertex_points.cl, a work-item per vertex); None: the Tessellator's ``work``."""
+        None: as ``work``).  work: "patch", "rows" (with ``MAX_ROWS_PER_PATCH``), "vertex" or
+        "point" (stages/vertex_points.cl, a work-item per vertex); None: the Tessellator's ``work``."""
         out = self._vertex_arrays(vertex_range[1] - vertex_range[0]) if out is None else out
         first, last = patch_range
         if vertex_range[1] == vertex_range[0] or last <= first:
@@ -520,10 +536,10 @@ class Tessellator:
         work = work or self.work
         if rows_per_patch is None and work == "rows":
             rows_per_patch = MAX_ROWS_PER_PATCH
-        if rows_per_patch is None and work == "point":  # work-items past the part's vertices return
+        if rows_per_patch is None and work in ("vertex", "point"):  # work-items past the part's vertices return
             event = self.programs.kernel("vertex_points", kind=kind, pattern=pattern)(
-                self.queue, _global_size(vertex_range[1] - vertex_range[0]), None, *arguments,
-                *(a.data for a in out.values()))
+                self.queue, _record_groups(vertex_range[1] - vertex_range[0]), (WORK_GROUP,), *arguments,
+                np.uint32(RECORDS_PER_ITEM), *(a.data for a in out.values()))
         elif rows_per_patch:
             event = self.programs.kernel("vertex_rows", kind=kind, pattern=pattern)(
                 self.queue, _global_size((last - first) * rows_per_patch), None, *arguments,
@@ -546,13 +562,14 @@ class Tessellator:
         if not n or last <= first:
             return triangles, []
         arguments = (factors.data, vertex_offsets.data, index_offsets.data, np.uint32(first),
-                     np.uint32(last - first), np.uint64(index_range[0]), triangles.data)
-        if (work or self.work) == "point":  # work-items past the part's triangles return
+                     np.uint32(last - first), np.uint64(index_range[0]))
+        if (work or self.work) == "point":  # work-items past the part's triangles stop
             event = self.programs.kernel("triangles", pattern=_pattern(kind))(
-                self.queue, _global_size(n // 3), None, *arguments)
+                self.queue, _record_groups(n // 3), (WORK_GROUP,), *arguments, np.uint32(RECORDS_PER_ITEM),
+                triangles.data)
         else:
             event = self.programs.kernel("indices", pattern=_pattern(kind))(
-                self.queue, _global_size(last - first), None, *arguments)
+                self.queue, _global_size(last - first), None, *arguments, triangles.data)
         return triangles, [event]
 
 
