@@ -14,12 +14,13 @@ On one OpenCL device, in this order, every figure a median (or the best, where s
    ``Tessellator.tessellate`` (fresh buffers), with the device's default work distribution;
    output bytes / device time as a fraction of the fill bandwidth; the session's read-back
    (``fetch``) rate against the page-locked bandwidth.
-2b. **Work distributions side by side** (``Tessellator(work=...)``: "patch", "rows", "point";
-   tessellator.py ``WORK_DISTRIBUTIONS``): on uniform level 16 and on each suite scene (0.5 px,
+2b. **Work distributions side by side** (``Tessellator(work=...)``: "patch", "rows", "vertex",
+   "point"; tessellator.py ``WORK_DISTRIBUTIONS``; "point/N": N records per work-item): on uniform level 16 and on each suite scene (0.5 px,
    its own camera), a ``Session`` per distribution; median device ms of stages 1-5, of stage 3
    (counts and scans), 4 and 5 over ``--repeat`` frames; bytes written; GB/s and the fraction
    of the fill bandwidth; and whether every distribution wrote the same bits (a hash of the
-   fetched output).  ``--variants-only`` runs sections 1, 2b and nothing else.
+   fetched output).  Then stage 3 with one scan of (vertex, index) pairs against two scans.
+   ``--variants-only`` runs sections 1, 2b and nothing else.
 3. **Frame loop on the paper's scenes** (``cltess bench``'s suite, 0.5 px): a ``Session``
    follows ``--frames`` cameras on a circle around each scene's camera target.  Per frame:
    the device time (sum of the stages' profiling spans), the host wall time until the stages
@@ -235,14 +236,20 @@ def output_digest(tess) -> str:
     return digest.hexdigest()
 
 
-def work_variants(tessellator, scenes, repeat: int, band: dict, works=WORK_DISTRIBUTIONS) -> list[dict]:
+#: The side-by-side table's variants: a work distribution, "/N": N records per work-item of the
+#: record kernels (Tessellator.records_per_item; without: RECORDS_PER_ITEM).
+VARIANTS = ["patch", "rows", "vertex", "point", "point/1", "point/16"]
+
+
+def work_variants(tessellator, scenes, repeat: int, band: dict, works=VARIANTS) -> list[dict]:
     """scenes: (name, Scene, request options).  One record per (scene, work distribution)."""
-    out, saved = [], tessellator.work
+    out, saved = [], (tessellator.work, tessellator.records_per_item)
     try:
         for name, scene, request in scenes:
             for work in works:
                 say(f"work distributions: {name}, {work}")
-                tessellator.work = work
+                tessellator.work, _, per_item = work.partition("/")
+                tessellator.records_per_item = int(per_item) if per_item else None
                 session = cltess.Session(scene, tessellator=tessellator, **request)
                 first = session.tessellate().fetch()  # builds, uploads; its bits
                 digest, size, triangles = output_digest(first), output_bytes(first), first.num_triangles
@@ -257,7 +264,7 @@ def work_variants(tessellator, scenes, repeat: int, band: dict, works=WORK_DISTR
                             "fraction_of_fill": size / (device / 1e3) / band["fill_bytes_per_s"]})
                 del runs, session
     finally:
-        tessellator.work = saved
+        tessellator.work, tessellator.records_per_item = saved
     return out
 
 
@@ -433,11 +440,16 @@ def main(argv=None) -> int:
     parser.add_argument("--copies", type=int, default=1000, help="teapots of the uniform level-16 scene")
     parser.add_argument("--bandwidth-mib", type=int, default=512, help="buffer of the fill and copy measurements")
     parser.add_argument("--json", help="write the record here too")
-    parser.add_argument("--work", nargs="*", default=list(WORK_DISTRIBUTIONS), choices=WORK_DISTRIBUTIONS,
-                        help="work distributions of the side-by-side table (default: all)")
+    parser.add_argument("--work", nargs="*", default=VARIANTS,
+                        help=f"work distributions of the side-by-side table ({', '.join(WORK_DISTRIBUTIONS)}; "
+                             f"'point/N': N records per work-item; default: {' '.join(VARIANTS)})")
     parser.add_argument("--variants-only", action="store_true",
                         help="bandwidth and the work distributions side by side only (no frame loop, no NumPy grid)")
     args = parser.parse_args(argv)
+    for work in args.work:
+        name, _, per_item = work.partition("/")
+        if name not in WORK_DISTRIBUTIONS or (per_item and not per_item.isdigit()):
+            parser.error(f"--work {work}: expected one of {', '.join(WORK_DISTRIBUTIONS)}, optionally /N")
     tessellator = Tessellator(args.device)
     record = {"device": device_info(tessellator.device), "machine": machine_info(), "frames": args.frames,
               "command": " ".join(sys.argv), "date": time.strftime("%Y-%m-%d %H:%M:%S %z"),

@@ -99,10 +99,10 @@ def _global_size(n: int) -> tuple[int]:
     return (max(WORK_GROUP, -(-n // WORK_GROUP) * WORK_GROUP),)
 
 
-def _record_groups(records: int) -> tuple[int]:
-    """Global size of the record kernels: WORK_GROUP work-items per RECORDS_PER_ITEM * WORK_GROUP
+def _record_groups(records: int, per_item: int) -> tuple[int]:
+    """Global size of the record kernels: WORK_GROUP work-items per per_item * WORK_GROUP
     records."""
-    per_group = RECORDS_PER_ITEM * WORK_GROUP
+    per_group = per_item * WORK_GROUP
     return (max(1, -(-records // per_group)) * WORK_GROUP,)
 
 
@@ -126,12 +126,19 @@ class Tessellator:
         rows_in_parallel=True is work="rows" (stages/vertex_rows.cl)."""
         self.device = device if isinstance(device, cl.Device) else pick_device(device)
         self.one_scan = os.environ.get("CLTESS_ONE_SCAN", "1") != "0"  # stage 3: one scan, else two
+        self.records_per_item = None  # stages/vertex_points.cl, triangles.cl: None is RECORDS_PER_ITEM
         self.work = "rows" if rows_in_parallel else work or default_work(self.device)
         if self.work not in WORK_DISTRIBUTIONS:
             raise ValueError(f"work={self.work!r}: expected one of {', '.join(WORK_DISTRIBUTIONS)}")
         self.context = cl.Context([self.device])
         self.queue = cl.CommandQueue(self.context, properties=cl.command_queue_properties.PROFILING_ENABLE)
         self.programs = Programs.of(self.context)
+
+    @property
+    def per_item(self) -> int:
+        """Records per work-item of the record kernels: ``records_per_item`` if set, else
+        ``RECORDS_PER_ITEM`` (read at each launch)."""
+        return self.records_per_item or RECORDS_PER_ITEM
 
     @property
     def rows_in_parallel(self) -> bool:
@@ -538,8 +545,8 @@ class Tessellator:
             rows_per_patch = MAX_ROWS_PER_PATCH
         if rows_per_patch is None and work in ("vertex", "point"):  # work-items past the part's vertices return
             event = self.programs.kernel("vertex_points", kind=kind, pattern=pattern)(
-                self.queue, _record_groups(vertex_range[1] - vertex_range[0]), (WORK_GROUP,), *arguments,
-                np.uint32(RECORDS_PER_ITEM), *(a.data for a in out.values()))
+                self.queue, _record_groups(vertex_range[1] - vertex_range[0], self.per_item), (WORK_GROUP,),
+                *arguments, np.uint32(self.per_item), *(a.data for a in out.values()))
         elif rows_per_patch:
             event = self.programs.kernel("vertex_rows", kind=kind, pattern=pattern)(
                 self.queue, _global_size((last - first) * rows_per_patch), None, *arguments,
@@ -565,8 +572,8 @@ class Tessellator:
                      np.uint32(last - first), np.uint64(index_range[0]))
         if (work or self.work) == "point":  # work-items past the part's triangles stop
             event = self.programs.kernel("triangles", pattern=_pattern(kind))(
-                self.queue, _record_groups(n // 3), (WORK_GROUP,), *arguments, np.uint32(RECORDS_PER_ITEM),
-                triangles.data)
+                self.queue, _record_groups(n // 3, self.per_item), (WORK_GROUP,), *arguments,
+                np.uint32(self.per_item), triangles.data)
         else:
             event = self.programs.kernel("indices", pattern=_pattern(kind))(
                 self.queue, _global_size(last - first), None, *arguments, triangles.data)
