@@ -10,10 +10,17 @@ On one OpenCL device, in this order, every figure a median (or the best, where s
    NumPy array: the read-back bandwidths, best of 3 (wall clock).
 2. **Uniform level 16.** 1,000 teapots (32,000 patches), every edge factor 16 (``max_factor``
    16, a tolerance every patch misses): 580 MB of output.  Device time of the five stages
-   through a ``Session`` (output buffers reused), the same with stage 4 a work-item per
-   (patch, row) (``Tessellator(rows_in_parallel=True)``, stages/vertex_rows.cl), and through
-   one-shot ``Tessellator.tessellate`` (fresh buffers); output bytes / device time as a fraction of the fill bandwidth; the
-   session's read-back (``fetch``) rate against the page-locked bandwidth.
+   through a ``Session`` (output buffers reused) and through one-shot
+   ``Tessellator.tessellate`` (fresh buffers), with the device's default work distribution;
+   output bytes / device time as a fraction of the fill bandwidth; the session's read-back
+   (``fetch``) rate against the page-locked bandwidth.
+2b. **Work distributions side by side** (``Tessellator(work=...)``: "patch", "rows", "vertex",
+   "point"; tessellator.py ``WORK_DISTRIBUTIONS``; "point/N": N records per work-item): on uniform level 16 and on each suite scene (0.5 px,
+   its own camera), a ``Session`` per distribution; median device ms of stages 1-5, of stage 3
+   (counts and scans), 4 and 5 over ``--repeat`` frames; bytes written; GB/s and the fraction
+   of the fill bandwidth; and whether every distribution wrote the same bits (a hash of the
+   fetched output).  Then stage 3 with one scan of (vertex, index) pairs against two scans.
+   ``--variants-only`` runs sections 1, 2b and nothing else.
 3. **Frame loop on the paper's scenes** (``cltess bench``'s suite, 0.5 px): a ``Session``
    follows ``--frames`` cameras on a circle around each scene's camera target.  Per frame:
    the device time (sum of the stages' profiling spans), the host wall time until the stages
@@ -36,6 +43,7 @@ for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):  # 
     os.environ.setdefault(_name, "1")
 
 import argparse  # noqa: E402
+import hashlib  # noqa: E402
 import json  # noqa: E402
 import math  # noqa: E402
 import statistics  # noqa: E402
@@ -48,6 +56,7 @@ import pyopencl as cl  # noqa: E402
 
 import cltess  # noqa: E402
 from cltess.backends.opencl import Tessellator  # noqa: E402
+from cltess.backends.opencl.tessellator import WORK_DISTRIBUTIONS  # noqa: E402
 from cltess.bench.suite import SUITE, device_info, machine_info, resolve_scenes  # noqa: E402
 from cltess.bench.scenes import PIXELS, mesh_camera  # noqa: E402
 from cltess.io import load_scene  # noqa: E402
@@ -56,6 +65,10 @@ from cltess.tessellation import BYTES_PER_INDEX, BYTES_PER_VERTEX  # noqa: E402
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
 WALL_KEYS = ("total_wall",)
+
+
+def say(text: str) -> None:
+    print(text, file=sys.stderr, flush=True)
 
 FILL_SOURCE = """
 __kernel void fill(__global float4 *out, const float4 value, const ulong count) {
@@ -202,18 +215,7 @@ def uniform(tessellator, scene, factor: int, repeat: int, band: dict) -> dict:
         one_shot.append((device_ms(tess), tess.wall_ms["total"]))
         del tess
     read_back = statistics.median(fetched)
-    tessellator.rows_in_parallel = True  # stage 4 a work-item per (patch, row): stages/vertex_rows.cl
-    try:
-        rows_session = cltess.Session(scene, tessellator=tessellator, **uniform_request(factor))
-        rows_session.tessellate()
-        rows = [rows_session.tessellate() for _ in range(repeat)]
-        rows_ms = {stage: statistics.median(r.stage_ms[stage] for r in rows) for stage in ("vertices", "indices")}
-        rows_device = statistics.median(device_ms(r) for r in rows)
-        del rows, rows_session
-    finally:
-        tessellator.rows_in_parallel = False
-    return {"rows_device_ms": rows_device, "rows_vertices_ms": rows_ms["vertices"],
-            "patches": scene.num_patches, "factor": factor, "triangles": first.num_triangles, "bytes": size,
+    return {            "patches": scene.num_patches, "factor": factor, "triangles": first.num_triangles, "bytes": size,
             "stage_ms": stage_ms, "device_ms": device,
             "vertices_indices_ms": stage_ms.get("vertices", 0) + stage_ms.get("indices", 0),
             "fraction_of_fill": size / (device / 1e3) / band["fill_bytes_per_s"],
@@ -222,6 +224,82 @@ def uniform(tessellator, scene, factor: int, repeat: int, band: dict) -> dict:
             "read_back_ms": read_back, "read_back_bytes_per_s": size / (read_back / 1e3) if read_back else math.inf,
             "one_shot_device_ms": statistics.median(d for d, _ in one_shot),
             "one_shot_total_ms": statistics.median(t for _, t in one_shot)}
+
+
+# --- 2b. the work distributions side by side ---------------------------------------------------
+
+def output_digest(tess) -> str:
+    """A hash of the fetched output (every vertex field and the triangles)."""
+    digest = hashlib.blake2b(digest_size=8)
+    for field in ("positions", "normals", "uv", "patch_ids", "object_ids", "triangles"):
+        digest.update(np.ascontiguousarray(getattr(tess, field)).tobytes())
+    return digest.hexdigest()
+
+
+#: The side-by-side table's variants: a work distribution, "/N": N records per work-item of the
+#: record kernels (Tessellator.records_per_item; without: RECORDS_PER_ITEM).
+VARIANTS = ["patch", "rows", "vertex", "point", "point/1", "point/16"]
+
+
+def work_variants(tessellator, scenes, repeat: int, band: dict, works=VARIANTS) -> list[dict]:
+    """scenes: (name, Scene, request options).  One record per (scene, work distribution)."""
+    out, saved = [], (tessellator.work, tessellator.records_per_item)
+    try:
+        for name, scene, request in scenes:
+            for work in works:
+                say(f"work distributions: {name}, {work}")
+                tessellator.work, _, per_item = work.partition("/")
+                tessellator.records_per_item = int(per_item) if per_item else None
+                session = cltess.Session(scene, tessellator=tessellator, **request)
+                first = session.tessellate().fetch()  # builds, uploads; its bits
+                digest, size, triangles = output_digest(first), output_bytes(first), first.num_triangles
+                del first
+                runs = [session.tessellate() for _ in range(repeat)]
+                stage = {key: statistics.median(r.stage_ms.get(key, 0.0) for r in runs)
+                         for key in ("counts", "vertices", "indices")}
+                device = statistics.median(device_ms(r) for r in runs)
+                out.append({"scene": name, "work": work, "triangles": triangles, "bytes": size, "digest": digest,
+                            "device_ms": device, "counts_ms": stage["counts"], "vertices_ms": stage["vertices"],
+                            "indices_ms": stage["indices"],
+                            "fraction_of_fill": size / (device / 1e3) / band["fill_bytes_per_s"]})
+                del runs, session
+    finally:
+        tessellator.work, tessellator.records_per_item = saved
+    return out
+
+
+def scan_variants(tessellator, scenes, repeat: int) -> list[dict]:
+    """Stage 3 (counts and offsets) with one scan of (vertex, index) pairs against two scans
+    (``Tessellator.one_scan``), median device ms over session frames, per scene."""
+    out, saved = [], tessellator.one_scan
+    try:
+        for name, scene, request in scenes:
+            row = {"scene": name, "patches": scene.num_patches}
+            for one in (True, False):
+                tessellator.one_scan = one
+                session = cltess.Session(scene, tessellator=tessellator, **request)
+                session.tessellate()
+                runs = [session.tessellate() for _ in range(repeat)]
+                row["one_scan_ms" if one else "two_scans_ms"] = statistics.median(r.stage_ms["counts"] for r in runs)
+                del runs, session
+            out.append(row)
+    finally:
+        tessellator.one_scan = saved
+    return out
+
+
+def variants_report(rows: list[dict], band: dict) -> list[str]:
+    lines = [f"Work distributions side by side (device ms, median of the frames; GB/s = bytes written / "
+             f"stages 1-5; fill {band['fill_bytes_per_s'] / 1e9:.1f} GB/s):", "",
+             "| scene | triangles | MB written | work | stages 1-5 ms | stage 3 ms | stage 4 ms | stage 5 ms | "
+             "GB/s | % of fill | same bits |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for row in rows:
+        peers = {r["digest"] for r in rows if r["scene"] == row["scene"]}
+        lines.append(f"| {row['scene']} | {row['triangles']:,} | {row['bytes'] / 1e6:.1f} | {row['work']} | "
+                     f"{row['device_ms']:.3f} | {row['counts_ms']:.3f} | {row['vertices_ms']:.3f} | "
+                     f"{row['indices_ms']:.3f} | {row['bytes'] / (row['device_ms'] / 1e3) / 1e9:.1f} | "
+                     f"{100 * row['fraction_of_fill']:.1f}% | {'yes' if len(peers) == 1 else 'NO'} |")
+    return lines
 
 
 # --- 4. the one-thread NumPy grid --------------------------------------------------------------
@@ -302,15 +380,25 @@ def grid_sizes(tessellator, sizes: list[tuple[int, int]], repeat: int) -> list[d
 # --- the report --------------------------------------------------------------------------------
 
 def report(record: dict) -> str:
-    band, level = record["bandwidth"], record["uniform"]
+    band = record["bandwidth"]
     gb = lambda x: f"{x / 1e9:.1f}"  # noqa: E731
     lines = [f"Device: {record['device']['name']} ({record['device']['platform']}); host "
              f"{record['machine']['cpu']}, {record['machine']['cpus']} CPUs; load average before "
-             f"{record['load_before']}, after {record['load_after']}.", "",
+             f"{record['load_before']}, after {record['load_after']}; default work distribution "
+             f"{record['default_work']}.", "",
              "| fill kernel write GB/s | device -> pinned host GB/s | device -> pageable host GB/s | buffer MiB |",
              "|---|---|---|---|",
              f"| {gb(band['fill_bytes_per_s'])} | {gb(band['pinned_read_bytes_per_s'])} | "
-             f"{gb(band['pageable_read_bytes_per_s'])} | {band['bytes'] >> 20} |", "",
+             f"{gb(band['pageable_read_bytes_per_s'])} | {band['bytes'] >> 20} |", ""]
+    lines += variants_report(record["variants"], band) + [""]
+    lines += ["Stage 3 (counts kernel and offsets scan), device ms, default work distribution:", "",
+              "| scene | patches | one scan of (vertex, index) pairs | two scans |", "|---|---|---|---|"]
+    lines += [f"| {r['scene']} | {r['patches']:,} | {r['one_scan_ms']:.3f} | {r['two_scans_ms']:.3f} |"
+              for r in record["scans"]] + [""]
+    if "uniform" not in record:  # --variants-only
+        return "\n".join(lines)
+    level = record["uniform"]
+    lines += [
              f"Uniform factor {level['factor']}, {level['patches']:,} patches, {level['triangles']:,} triangles, "
              f"{level['bytes'] / 1e6:.0f} MB of output:", "",
              "| | ms | GB/s of output | % of fill bandwidth |", "|---|---|---|---|"]
@@ -318,8 +406,6 @@ def report(record: dict) -> str:
     for label, ms in (("device, stages 1-5 (session)", level["device_ms"]),
                       ("device, stages 4-5 (session)", level["vertices_indices_ms"]),
                       ("device, stage 4 alone (session)", level["stage_ms"].get("vertices", 0.0)),
-                      ("device, stages 1-5, stage 4 a work-item per row (session)", level["rows_device_ms"]),
-                      ("device, stage 4 alone, a work-item per row (session)", level["rows_vertices_ms"]),
                       ("device, stages 1-5 (one-shot, fresh buffers)", level["one_shot_device_ms"]),
                       ("one-shot end to end, host arrays", level["one_shot_total_ms"]),
                       ("session read-back (fetch)", level["read_back_ms"])):
@@ -354,24 +440,41 @@ def main(argv=None) -> int:
     parser.add_argument("--copies", type=int, default=1000, help="teapots of the uniform level-16 scene")
     parser.add_argument("--bandwidth-mib", type=int, default=512, help="buffer of the fill and copy measurements")
     parser.add_argument("--json", help="write the record here too")
+    parser.add_argument("--work", nargs="*", default=VARIANTS,
+                        help=f"work distributions of the side-by-side table ({', '.join(WORK_DISTRIBUTIONS)}; "
+                             f"'point/N': N records per work-item; default: {' '.join(VARIANTS)})")
+    parser.add_argument("--variants-only", action="store_true",
+                        help="bandwidth and the work distributions side by side only (no frame loop, no NumPy grid)")
     args = parser.parse_args(argv)
+    for work in args.work:
+        name, _, per_item = work.partition("/")
+        if name not in WORK_DISTRIBUTIONS or (per_item and not per_item.isdigit()):
+            parser.error(f"--work {work}: expected one of {', '.join(WORK_DISTRIBUTIONS)}, optionally /N")
     tessellator = Tessellator(args.device)
-    say = lambda text: print(text, file=sys.stderr, flush=True)  # noqa: E731
     record = {"device": device_info(tessellator.device), "machine": machine_info(), "frames": args.frames,
               "command": " ".join(sys.argv), "date": time.strftime("%Y-%m-%d %H:%M:%S %z"),
-              "load_before": [round(x, 1) for x in os.getloadavg()]}
+              "load_before": [round(x, 1) for x in os.getloadavg()], "default_work": tessellator.work}
     say("bandwidth")
     size = min(args.bandwidth_mib << 20, tessellator.device.max_mem_alloc_size // 2)
     record["bandwidth"] = bandwidths(tessellator, size)
-    say("uniform level 16")
-    record["uniform"] = uniform(tessellator, teapots(args.copies), 16, args.repeat, record["bandwidth"])
-    record["frame_loop"] = []
-    for key in resolve_scenes(args.scenes):
-        say(f"frame loop: {key}")
-        record["frame_loop"].append(frame_loop(tessellator, key, args.frames))
-    say("NumPy grid")
-    sizes = [(1, 13), (10, 13), (100, 13), (1000, 13)]  # about 10k, 100k, 1M, 10M triangles
-    record["grid"] = grid_sizes(tessellator, sizes, args.repeat)
+    keys = resolve_scenes(args.scenes)
+    level16 = teapots(args.copies)
+    scenes = [(f"uniform 16 ({level16.num_patches:,} patches)", level16, uniform_request(16))]
+    scenes += [(key, suite_scene(key), {"pixels": PIXELS}) for key in keys]
+    record["variants"] = work_variants(tessellator, scenes, args.repeat, record["bandwidth"], args.work)
+    say("stage 3: one scan, two scans")
+    record["scans"] = scan_variants(tessellator, scenes, args.repeat)
+    del scenes
+    if not args.variants_only:
+        say("uniform level 16")
+        record["uniform"] = uniform(tessellator, level16, 16, args.repeat, record["bandwidth"])
+        record["frame_loop"] = []
+        for key in keys:
+            say(f"frame loop: {key}")
+            record["frame_loop"].append(frame_loop(tessellator, key, args.frames))
+        say("NumPy grid")
+        sizes = [(1, 13), (10, 13), (100, 13), (1000, 13)]  # about 10k, 100k, 1M, 10M triangles
+        record["grid"] = grid_sizes(tessellator, sizes, args.repeat)
     record["load_after"] = [round(x, 1) for x in os.getloadavg()]
     print(report(record))
     if args.json:

@@ -4,6 +4,7 @@
 #
 #   bash bench/gpu_issues.sh OUTDIR speed      # bench/frame_loop.py, bench/semi_uniform.py
 #   bash bench/gpu_issues.sh OUTDIR patterns   # bench/silhouette.py, bench/sd2.py, bench/esc.py
+#   bash bench/gpu_issues.sh OUTDIR kernels    # issue 15's work distributions side by side, bitwise tests
 #
 # Expects in .whl/ the Python 3.12 manylinux x86_64 wheels of pyopencl and its dependencies,
 # mako, trimesh, tqdm (as bench/gpu_run.sh) and NVIDIA's OpenCL library in
@@ -11,7 +12,7 @@
 # take the others with it; its output and exit code are in OUTDIR.
 set -u
 out=${1:?usage: bash bench/gpu_issues.sh OUTDIR speed|patterns}
-which=${2:?usage: bash bench/gpu_issues.sh OUTDIR speed|patterns}
+which=${2:?usage: bash bench/gpu_issues.sh OUTDIR speed|patterns|kernels}
 . bench/gpu_setup.sh
 { nvidia-smi -L; python3 -m cltess devices; } > "$out/machine-$which.txt" 2>&1
 run() {  # run NAME SECONDS COMMAND...
@@ -28,4 +29,7 @@ case $which in
     run silhouette 200 python3 bench/silhouette.py --device nvidia --quality --json "$out/silhouette.json"
     run sd2 150 python3 bench/sd2.py --device nvidia --json "$out/sd2.json"
     run esc 200 python3 bench/esc.py --device nvidia --json "$out/esc.json" --csv "$out/esc.csv" ;;
+  kernels)
+    run frame_loop_variants 400 python3 bench/frame_loop.py --device nvidia --variants-only --json "$out/frame_loop_variants.json"
+    run work_points_tests 150 env CLTESS_DEVICE=nvidia python3 -m pytest -q -p no:cacheprovider tests/test_work_points.py ;;
 esac

@@ -259,6 +259,22 @@ inline int batch_patch(uint first_patch, uint num_patches, __global const int4 *
     return f->s0 > 0;
 }
 
+/* The patch owning output slot `at` (a vertex, or an index; global numbering) among patches
+ * lo .. hi - 1 whose slots start at offsets[p] (stage 3's scan): the last p with offsets[p] <= at
+ * (binary search; a culled patch owns no slot, so the one found is never culled).  Needs
+ * offsets[lo] <= at < offsets[hi].  Stages 4-5 a work-item per vertex or triangle. */
+inline uint patch_of(__global const ulong *offsets, uint lo, uint hi, ulong at)
+{
+    while (hi - lo > 1) {
+        uint mid = lo + (hi - lo) / 2;
+        if (offsets[mid] <= at)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
 inline void load_patch(__global const float4 *patches, uint p, float4 b[16])
 {
     for (int k = 0; k < 16; ++k)

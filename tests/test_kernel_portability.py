@@ -30,6 +30,8 @@ def compositions():
                 for stage in STAGES:
                     yield stage, composition(stage, kind=kind, pattern=pattern, tolerance=tolerance)
             yield "vertex_rows", composition("vertex_rows", kind=kind, pattern=pattern)  # issue 15
+            yield "vertex_points", composition("vertex_points", kind=kind, pattern=pattern)
+            yield "triangles", composition("triangles", pattern=pattern)
         semi_uniform = pattern_named("semi_uniform", kind.domain)
         yield "level_vertices", composition("level_vertices", kind=kind, pattern=semi_uniform)  # by level
         yield "level_indices", composition("level_indices", pattern=semi_uniform)

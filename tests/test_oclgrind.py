@@ -36,7 +36,8 @@ from cltess.device import list_devices
 from cltess.io.npz import load_npz
 
 HERE = Path(__file__).resolve().parent
-NAMES = [*scenarios.SCENARIOS, *scenarios.BATCHED, *scenarios.BY_LEVEL, *scenarios.ROWS_IN_PARALLEL, *scenarios.SILHOUETTE]
+NAMES = [*scenarios.SCENARIOS, *scenarios.BATCHED, *scenarios.BY_LEVEL, *scenarios.ROWS_IN_PARALLEL, *scenarios.POINTS,
+         *scenarios.SILHOUETTE]
 
 PASSES = {
     "checks": dict(env=scenarios.OCLGRIND_ENV, args=[],
@@ -254,6 +255,11 @@ def test_results_match_pocl(oclgrind, tmp_path_factory, tessellator, pass_name):
                 by_rows = load_npz(run.out_dir / f"{rows}.npz")
                 for field in ("positions", "normals", "uv", "patch_ids", "object_ids", "triangles"):
                     assert np.array_equal(getattr(by_rows, field), getattr(got, field)), f"{rows}: {field}"
+        for points, base in scenarios.POINTS.items():  # stages/vertex_points.cl, triangles.cl: bitwise
+            if (base[0] if isinstance(base, tuple) else base) == name and points in run.results:
+                by_points = load_npz(run.out_dir / f"{points}.npz")
+                for field in ("positions", "normals", "uv", "patch_ids", "object_ids", "triangles"):
+                    assert np.array_equal(getattr(by_points, field), getattr(got, field)), f"{points}: {field}"
         if name in scenarios.VERIFIED:
             plan = tessellator.plan(scene, **options)
             ours = tessellator.verify(scene, plan, tessellator.emit(plan, 0, plan.num_patches))

@@ -100,6 +100,25 @@ inline void grid_cells(__global uint *out, uint *count, uint base, pattern_grid 
         }
 }
 
+/* Triangle t of a patch whose triangles are the plain A x B grid (uniform factors, no collapsed
+ * edge): *triangle its local vertex numbers, as grid_cells emits them (cell t / 2 row by row,
+ * then (a, b, c) and (a, c, d)).  Returns 0 for any other patch, whose triangles only
+ * pattern_primitives makes.  Stage 5 a work-item per triangle (stages/triangles.cl) uses it. */
+#define PATTERN_TRIANGLE_AT 1
+inline int pattern_triangle_at(int4 f, int collapsed, uint t, __private uint3 *triangle)
+{
+    pattern_grid g = quad_grid(f);
+    if (!g.uniform || collapsed)
+        return 0;
+    uint cell = t >> 1;
+    int i = (int)(cell % (uint)g.core.x), j = (int)(cell / (uint)g.core.x);
+    uint a = pattern_grid_index(g, (int2)(i, j)), c = pattern_grid_index(g, (int2)(i + 1, j + 1));
+    uint b = (t & 1) ? c : pattern_grid_index(g, (int2)(i + 1, j));
+    uint d = (t & 1) ? pattern_grid_index(g, (int2)(i, j + 1)) : c;
+    *triangle = (uint3)(a, b, d);
+    return 1;
+}
+
 /* The triangles, in "count" mode (out == 0) or "emit" mode (out != 0): one routine, so the counts
  * of stage 3 and the indices of stage 5 cannot disagree.  Returns the number of triangles;
  * vertex numbers are offset by base.  collapsed: bit e for a collapsed edge e (patch_factors),

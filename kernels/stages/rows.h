@@ -1,26 +1,34 @@
 /* Stage 4's vertices of one patch in the pattern's layout (patterns/layout.h), shared by
- * stages/vertices.cl (a work-item per patch) and stages/vertex_rows.cl (a work-item per run of
- * rows), so both write the same bits.  Built against a kind header and a pattern header. */
+ * stages/vertices.cl (a work-item per patch), stages/vertex_rows.cl (a work-item per run of
+ * rows) and stages/vertex_points.cl (a work-item per vertex), so all three write the same bits.
+ * Built against a kind header and a pattern header. */
 #ifndef CLTESS_STAGES_ROWS_H
 #define CLTESS_STAGES_ROWS_H
 
-/* The ring of patch p from output slot at; returns the slot after it.  Each point is placed
- * canonically on its edge by the kind (kind_boundary_point: bitwise the neighbour's); a
- * collapsed edge's points are all its first corner. */
+/* Ring point k of edge e: its domain point *x and its position, placed canonically on its edge
+ * by the kind (kind_boundary_point: bitwise the neighbour's); a collapsed edge's points are all
+ * its first corner.  Its normal is kind_eval's at *x. */
+ALWAYS_INLINE float3 ring_position(__private const kind_patch *patch, int4 f, int collapsed, int e, int k,
+                                   __private float3 *x)
+{
+    edge_param t = pattern_ring_param(f, e, k);
+    *x = pattern_edge_point(e, t);
+    edge_param corner = {0, t.f};
+    return kind_boundary_point(patch, e, (collapsed >> e) & 1 ? corner : t);
+}
+
+/* The ring of patch p from output slot at; returns the slot after it. */
 ALWAYS_INLINE ulong put_ring(__private const kind_patch *patch, int4 f, int collapsed, vertex_out out, ulong at,
                              uint p, int object)
 {
-    float3 normal;
+    float3 normal, x;
     __attribute__((opencl_unroll_hint))  /* e constant in each copy: the edge's data in registers */
     for (int e = 0; e < PATTERN_EDGES; ++e) {
         int ring_count = PATTERN_EDGE_POINTS(f, e);
         for (int k = 0; k < ring_count; ++k) {
-            edge_param t = pattern_ring_param(f, e, k);
-            float3 x = pattern_edge_point(e, t);
+            float3 position = ring_position(patch, f, collapsed, e, k, &x);
             kind_eval(patch, x, 0, &normal);  /* the normal; the position is the edge's */
-            edge_param corner = {0, t.f};
-            put_vertex(out, at++, kind_boundary_point(patch, e, (collapsed >> e) & 1 ? corner : t), normal, x.xy,
-                       p, object);
+            put_vertex(out, at++, position, normal, x.xy, p, object);
         }
     }
     return at;
@@ -55,6 +63,54 @@ ALWAYS_INLINE void put_rows(__private const kind_patch *patch, int4 f, int first
             }
         }
     }
+}
+
+/* Vertex v (0 .. pattern_vertex_count(f) - 1) of patch p alone, to output slot at, bitwise what
+ * put_ring / put_rows write there: a ring point as put_ring computes it; a row point directly,
+ * or by forward differencing replayed from its row's start (kind_row_begin, then kind_row_next
+ * i times: the same operations in the same order as put_rows, so the same bits; the earlier
+ * steps' positions and normals are dead and left out by the compiler). */
+ALWAYS_INLINE void put_point(__private const kind_patch *patch, int4 f, int collapsed, uint v,
+                             int forward_differencing, vertex_out out, ulong at, uint p, int object)
+{
+#if !PATTERN_UNIFORM_ROWS
+    forward_differencing = 0;
+#endif
+    float3 x, position, normal;
+    int on_ring = 0;
+    __attribute__((opencl_unroll_hint))  /* e constant in each copy, as in put_ring */
+    for (int e = 0; e < PATTERN_EDGES; ++e) {
+        uint ring_count = (uint)PATTERN_EDGE_POINTS(f, e);
+        if (!on_ring && v < ring_count) {
+            position = ring_position(patch, f, collapsed, e, (int)v, &x);
+            on_ring = 1;
+        } else if (!on_ring) {
+            v -= ring_count;
+        }
+    }
+    if (on_ring) {
+        kind_eval(patch, x, 0, &normal);
+        put_vertex(out, at, position, normal, x.xy, p, object);
+        return;
+    }
+    int rows = pattern_rows(f), j = 1, steps = pattern_row(f, 1);  /* row j holds points 1 .. steps - 1 */
+    while (j < rows && v >= (uint)(steps - 1)) {
+        v -= (uint)(steps - 1);
+        steps = pattern_row(f, ++j);
+    }
+    int i = (int)v + 1;
+    x = pattern_row_point(f, j, i);
+    if (forward_differencing) {
+        kind_row row;
+        float3 unused_position, unused_normal;
+        kind_row_begin(patch, pattern_row_point(f, j, 0), pattern_row_point(f, j, steps), steps, &row);
+        for (int s = 1; s < i; ++s)
+            kind_row_next(patch, &row, pattern_row_point(f, j, s), &unused_position, &unused_normal);
+        kind_row_next(patch, &row, x, &position, &normal);
+    } else {
+        kind_eval(patch, x, &position, &normal);
+    }
+    put_vertex(out, at, position, normal, x.xy, p, object);
 }
 
 #endif

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 import pyopencl as cl
 from pyopencl.scan import GenericScanKernel
+from pyopencl.tools import get_or_register_dtype, match_dtype_to_c_struct
 
 from ...device import BuildError, first_error_line
 
@@ -29,7 +30,9 @@ STAGE_AXES = {
     # stages 4-5 by level (levels.py), for a pattern with a template: built when asked for
     "level_vertices": ("kind", "pattern"),
     "level_indices": ("pattern",),  # two kernels: level_interior, level_band
-    "vertex_rows": ("kind", "pattern"),  # stage 4 a work-item per row (Tessellator(rows_in_parallel=True))
+    "vertex_rows": ("kind", "pattern"),  # stage 4 a work-item per row (Tessellator(work="rows"))
+    "vertex_points": ("kind", "pattern"),  # stage 4 a work-item per vertex (Tessellator(work="point"))
+    "triangles": ("pattern",),  # stage 5 a work-item per triangle (Tessellator(work="point"))
     "verify": ("kind",),  # on request only (Tessellator.verify), so not in STAGES
     # silhouette refinement per frame (silhouette.py; they include criteria/silhouette.h)
     "silhouette_alpha": (),
@@ -43,6 +46,15 @@ STAGE_AXES = {
     "vertex_bounds": ("level",),
     "level_factors": ("level",),
 }
+
+OFFSET_PAIR_FUNCTIONS = """
+offset_pair offset_pair_of(ulong v, ulong i) { offset_pair p; p.v = v; p.i = i; return p; }
+offset_pair offset_pair_add(offset_pair a, offset_pair b) { return offset_pair_of(a.v + b.v, a.i + b.i); }
+"""
+
+#: The stage 4-5 programs of a work distribution other than a patch per work-item
+#: (tessellator.py WORK_DISTRIBUTIONS).
+WORK_STAGES = {"rows": ("vertex_rows",), "vertex": ("vertex_points",), "point": ("vertex_points", "triangles")}
 
 
 def kernel_dir() -> Path:
@@ -99,6 +111,18 @@ class Programs:
             context, np.uint64, arguments="__global const ulong *counts, __global ulong *offsets",
             input_expr="counts[i]", scan_expr="a+b", neutral="0",
             output_statement="offsets[i + 1] = item;")
+        # Stage 3's vertex and index offsets in one scan of (vertex, index) pairs: a struct of two
+        # ulongs (8-byte aligned; a ulong2 was stored misaligned in the scan's local memory).
+        pair, declaration = match_dtype_to_c_struct(context.devices[0], "offset_pair",
+                                                    np.dtype([("v", np.uint64), ("i", np.uint64)]))
+        pair = get_or_register_dtype("offset_pair", pair)
+        self.offsets_pair_scan = GenericScanKernel(
+            context, pair, preamble=declaration + OFFSET_PAIR_FUNCTIONS,
+            arguments="__global const ulong *vertex_counts, __global const ulong *index_counts, "
+                      "__global ulong *vertex_offsets, __global ulong *index_offsets",
+            input_expr="offset_pair_of(vertex_counts[i], index_counts[i])", scan_expr="offset_pair_add(a, b)",
+            neutral="offset_pair_of(0, 0)",
+            output_statement="vertex_offsets[i + 1] = item.v; index_offsets[i + 1] = item.i;")
 
     def kernel(self, stage: str, entry: str | None = None, **axes) -> cl.Kernel:
         """The stage's kernel composed for ``axes`` (kind=, pattern=, tolerance=, crack=): the
@@ -111,9 +135,10 @@ class Programs:
             self._kernels[key, entry] = getattr(self._programs[key], entry or stage)
         return self._kernels[key, entry]
 
-    def compose(self, kind, pattern, tolerance) -> None:
-        """Build (or find) every stage's program for one (kind, pattern, tolerance) now."""
-        for stage in STAGES:
+    def compose(self, kind, pattern, tolerance, work: str = "patch") -> None:
+        """Build (or find) every stage's program for one (kind, pattern, tolerance) now, and the
+        stage 4-5 kernels of a work distribution (``WORK_STAGES``)."""
+        for stage in STAGES + WORK_STAGES.get(work, ()):
             self.kernel(stage, kind=kind, pattern=pattern, tolerance=tolerance, crack=pattern.crack)
 
     def build(self, stage: str, headers: tuple, defines: dict) -> cl.Program:

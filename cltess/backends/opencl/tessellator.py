@@ -20,6 +20,7 @@ and every ``cltess.Session`` frame: ``OutputBuffers``, ``DeviceOutput``).
 from __future__ import annotations
 
 import math
+import os
 import time
 from dataclasses import dataclass, field
 
@@ -46,6 +47,32 @@ WORK_GROUP = 64  # global sizes are rounded up to this; kernels guard their inde
 #: stages/vertex_rows.cl: work-items per patch (the ring and 64 rows; a patch with more rows has
 #: its last work-item do the rest, so this is a speed setting, never a limit).
 MAX_ROWS_PER_PATCH = 65
+#: stages/vertex_points.cl and stages/triangles.cl: records per work-item (a work-group of
+#: WORK_GROUP work-items owns WORK_GROUP * this consecutive records, written side by side in
+#: steps; a patch is found and loaded once per work-item and patch, not per record).
+RECORDS_PER_ITEM = 4
+#: How stages 4-5 spread their work (docs/design.md, "Work distribution"): "patch" a work-item
+#: per patch (stages/vertices.cl, stages/indices.cl); "rows" stage 4 a work-item per (patch,
+#: row) (stages/vertex_rows.cl), stage 5 per patch; "vertex" stage 4 a work-item per output
+#: vertex (stages/vertex_points.cl), stage 5 per patch; "point" a work-item per output vertex and
+#: per output triangle (stages/vertex_points.cl, stages/triangles.cl: consecutive work-items
+#: write consecutive records).  All write the same bits.
+WORK_DISTRIBUTIONS = ("patch", "rows", "vertex", "point")
+#: The default per device type, chosen by bench/frame_loop.py (bench/RESULTS.md, "Issue 15:
+#: kernels"): CPUs keep a patch per work-item (the point kernels replay forward differencing
+#: per vertex: more arithmetic, which a CPU pays); GPUs a work-item per vertex and triangle.
+DEFAULT_WORK = {"gpu": "point", "other": "patch"}
+
+
+def default_work(device: cl.Device) -> str:
+    """The work distribution for a device: ``CLTESS_WORK`` if set, else ``DEFAULT_WORK``."""
+    gpu = device.type & cl.device_type.GPU and not device.type & cl.device_type.CPU  # Oclgrind says "all"
+    chosen = os.environ.get("CLTESS_WORK") or DEFAULT_WORK["gpu" if gpu else "other"]
+    if chosen not in WORK_DISTRIBUTIONS:
+        raise ValueError(f"CLTESS_WORK={chosen!r}: expected one of {', '.join(WORK_DISTRIBUTIONS)}")
+    return chosen
+
+
 VERIFY_ORDER = 6  # Tessellator.verify: 28 points per triangle, corners and edges included
 VERIFY_MAX_TRIANGLES = 4_000_000  # above this, every k-th triangle is verified
 
@@ -74,6 +101,13 @@ def _global_size(n: int) -> tuple[int]:
     return (max(WORK_GROUP, -(-n // WORK_GROUP) * WORK_GROUP),)
 
 
+def _record_groups(records: int, per_item: int) -> tuple[int]:
+    """Global size of the record kernels: WORK_GROUP work-items per per_item * WORK_GROUP
+    records."""
+    per_group = per_item * WORK_GROUP
+    return (max(1, -(-records // per_group)) * WORK_GROUP,)
+
+
 def _span_ms(events) -> float:
     """Device milliseconds from the first event's start to the last one's end."""
     return (events[-1].profile.end - events[0].profile.start) * 1e-6
@@ -87,15 +121,35 @@ class Tessellator:
 
     name = "opencl"
 
-    def __init__(self, device: cl.Device | str | None = None, rows_in_parallel: bool = False):
-        """rows_in_parallel: stage 4 with a work-item per (patch, row) (stages/vertex_rows.cl,
-        bitwise the same output) rather than per patch: more parallelism for a GPU; off by
-        default until measured there (bench/frame_loop.py times both)."""
-        self.rows_in_parallel = rows_in_parallel
+    def __init__(self, device: cl.Device | str | None = None, rows_in_parallel: bool = False,
+                 work: str | None = None):
+        """work: how stages 4-5 spread over work-items (``WORK_DISTRIBUTIONS``: "patch", "rows",
+        "vertex" or "point", bitwise the same output); default per device type (``default_work``).
+        rows_in_parallel=True is work="rows" (stages/vertex_rows.cl)."""
         self.device = device if isinstance(device, cl.Device) else pick_device(device)
+        self.one_scan = os.environ.get("CLTESS_ONE_SCAN", "1") != "0"  # stage 3: one scan, else two
+        self.records_per_item = None  # stages/vertex_points.cl, triangles.cl: None is RECORDS_PER_ITEM
+        self.work = "rows" if rows_in_parallel else work or default_work(self.device)
+        if self.work not in WORK_DISTRIBUTIONS:
+            raise ValueError(f"work={self.work!r}: expected one of {', '.join(WORK_DISTRIBUTIONS)}")
         self.context = cl.Context([self.device])
         self.queue = cl.CommandQueue(self.context, properties=cl.command_queue_properties.PROFILING_ENABLE)
         self.programs = Programs.of(self.context)
+
+    @property
+    def per_item(self) -> int:
+        """Records per work-item of the record kernels: ``records_per_item`` if set, else
+        ``RECORDS_PER_ITEM`` (read at each launch)."""
+        return self.records_per_item or RECORDS_PER_ITEM
+
+    @property
+    def rows_in_parallel(self) -> bool:
+        """Stage 4 a work-item per (patch, row): work == "rows"."""
+        return self.work == "rows"
+
+    @rows_in_parallel.setter
+    def rows_in_parallel(self, on: bool) -> None:
+        self.work = "rows" if on else ("patch" if self.work == "rows" else self.work)
 
     def tessellate(self, scene: Scene, request: Request | None = None, **options) -> Tessellation:
         """Run the five stages on a scene; returns the mesh and per-stage device times.
@@ -139,7 +193,7 @@ class Tessellator:
         for kind in KINDS:
             if kind.count(scene):
                 pattern = request.pattern_for(kind)
-                self.programs.compose(kind, pattern, tolerance)
+                self.programs.compose(kind, pattern, tolerance, self.work)
                 if pattern.fixed_point:  # SD-2's level functions
                     build_level_function_programs(self)
                 if pattern.primitive == "strips":
@@ -456,10 +510,12 @@ class Tessellator:
         events = [self.programs.kernel("counts", pattern=_pattern(k))(
             self.queue, _global_size(n), None, factors.data, np.uint32(n), np.uint32(base),
             vertex_counts.data, index_counts.data) for k, base, n in ranges if n]
-        # Two scans: one scan of (vertex, index) pairs as ulong2 was misaligned in pyopencl's local
-        # memory, and a segmented one read uninitialised flags (both Oclgrind, issue 15).
-        events += [self.programs.offsets_scan(vertex_counts, vertex_offsets),
-                   self.programs.offsets_scan(index_counts, index_offsets)]
+        if self.one_scan:  # both offsets in one scan of (vertex, index) pairs (programs.py)
+            events.append(self.programs.offsets_pair_scan(vertex_counts, index_counts, vertex_offsets,
+                                                          index_offsets))
+        else:
+            events += [self.programs.offsets_scan(vertex_counts, vertex_offsets),
+                       self.programs.offsets_scan(index_counts, index_offsets)]
         return vertex_offsets, index_offsets, events
 
     def _vertex_arrays(self, n: int) -> dict:
@@ -468,14 +524,15 @@ class Tessellator:
 
     def stage_vertices(self, controls, factors, vertex_offsets, patch_objects, vertex_range,
                        patch_range, forward_differencing=True, kind=BEZIER, patch_base=0, out=None,
-                       pattern=None, rows_per_patch: int | None = None):
+                       pattern=None, rows_per_patch: int | None = None, work: str | None = None):
         """Stage 4 for patches patch_range = (first, last) (scene numbers, all of one kind whose
         first patch is patch_base; controls: that kind's stage-4 input, Bézier patches or PN
         control points), whose vertices are vertex_range = (start, stop) -> dict of positions
         (V, 3), normals (V, 3), uv (V, 2), patch_ids (V,), object_ids (V,) device arrays,
         V = stop - start (written into ``out`` when given), and the events.  rows_per_patch:
         work-items per patch of stages/vertex_rows.cl (0: one per patch, stages/vertices.cl;
-        None: as the Tessellator's ``rows_in_parallel``, with ``MAX_ROWS_PER_PATCH``)."""
+        None: as ``work``).  work: "patch", "rows" (with ``MAX_ROWS_PER_PATCH``), "vertex" or
+        "point" (stages/vertex_points.cl, a work-item per vertex); None: the Tessellator's ``work``."""
         out = self._vertex_arrays(vertex_range[1] - vertex_range[0]) if out is None else out
         first, last = patch_range
         if vertex_range[1] == vertex_range[0] or last <= first:
@@ -485,9 +542,14 @@ class Tessellator:
         arguments = (controls.data, factors.data, vertex_offsets.data, patch_objects.data, np.uint32(first),
                      np.uint32(last - first), np.uint32(patch_base), np.uint64(vertex_range[0]),
                      np.int32(forward_differencing))
-        if rows_per_patch is None and self.rows_in_parallel:
+        work = work or self.work
+        if rows_per_patch is None and work == "rows":
             rows_per_patch = MAX_ROWS_PER_PATCH
-        if rows_per_patch:
+        if rows_per_patch is None and work in ("vertex", "point"):  # work-items past the part's vertices return
+            event = self.programs.kernel("vertex_points", kind=kind, pattern=pattern)(
+                self.queue, _record_groups(vertex_range[1] - vertex_range[0], self.per_item), (WORK_GROUP,),
+                *arguments, np.uint32(self.per_item), *(a.data for a in out.values()))
+        elif rows_per_patch:
             event = self.programs.kernel("vertex_rows", kind=kind, pattern=pattern)(
                 self.queue, _global_size((last - first) * rows_per_patch), None, *arguments,
                 np.uint32(rows_per_patch), *(a.data for a in out.values()))
@@ -497,20 +559,26 @@ class Tessellator:
         return out, [event]
 
     def stage_indices(self, factors, vertex_offsets, index_offsets, index_range, patch_range,
-                      kind=BEZIER, out=None):
+                      kind=BEZIER, out=None, work: str | None = None):
         """Stage 5 for patches patch_range = (first, last) (scene numbers, all of one kind or
-        pattern),
-        whose indices are index_range = (start, stop) -> triangles ((stop - start) / 3, 3) uint32
-        device array (``out`` when given), and the events."""
+        pattern), whose indices are index_range = (start, stop) -> triangles ((stop - start) / 3,
+        3) uint32 device array (``out`` when given), and the events.  work: "point" a work-item
+        per triangle (stages/triangles.cl), else per patch (stages/indices.cl); None: the
+        Tessellator's ``work``."""
         n = index_range[1] - index_range[0]
         triangles = cl_array.empty(self.queue, (n // 3, 3), np.uint32) if out is None else out
         first, last = patch_range
         if not n or last <= first:
             return triangles, []
-        event = self.programs.kernel("indices", pattern=_pattern(kind))(
-            self.queue, _global_size(last - first), None, factors.data, vertex_offsets.data,
-            index_offsets.data, np.uint32(first), np.uint32(last - first), np.uint64(index_range[0]),
-            triangles.data)
+        arguments = (factors.data, vertex_offsets.data, index_offsets.data, np.uint32(first),
+                     np.uint32(last - first), np.uint64(index_range[0]))
+        if (work or self.work) == "point":  # work-items past the part's triangles stop
+            event = self.programs.kernel("triangles", pattern=_pattern(kind))(
+                self.queue, _record_groups(n // 3, self.per_item), (WORK_GROUP,), *arguments,
+                np.uint32(self.per_item), triangles.data)
+        else:
+            event = self.programs.kernel("indices", pattern=_pattern(kind))(
+                self.queue, _global_size(last - first), None, *arguments, triangles.data)
         return triangles, [event]
 
 

@@ -1,0 +1,41 @@
+/* Stage 5 a work-item per output triangle (issue 15, for GPUs): consecutive work-items write
+ * consecutive triangles (coalesced stores).  As stages/vertex_points.cl: a work-group of G
+ * work-items owns G * per_item consecutive triangles of the batch, in step k its work-item l
+ * writes triangle k G + l of them, and it finds a triangle's patch by patch_of (common.h) over
+ * index_offsets only when the patch changes (64-bit divisions by 3 only then).  A pattern with
+ * random access to a regular patch's triangles (PATTERN_TRIANGLE_AT, pattern_triangle_at) gives
+ * triangle t directly; any other patch is emitted whole by the work-item of its triangle 0 with
+ * pattern_primitives, as stages/indices.cl does.  Either way the bits of stages/indices.cl.
+ * The batch is patches first_patch .. first_patch + num_patches - 1; work-items past its last
+ * triangle stop. */
+__kernel void triangles(__global const int4 *factors, __global const ulong *vertex_offsets,
+                        __global const ulong *index_offsets, uint first_patch, uint num_patches,
+                        ulong index_base, uint per_item, __global uint *indices)
+{
+    uint last = first_patch + num_patches;
+    ulong end = index_offsets[last] / 3, group = get_local_size(0), first_triangle = index_base / 3;
+    ulong at = index_offsets[first_patch] / 3 + get_group_id(0) * group * per_item + get_local_id(0);  /* a triangle */
+    uint p = first_patch, base = 0;
+    ulong patch_start = 0, patch_end = 0;  /* the patch's triangles; none found yet */
+    int4 f = (int4)(0);
+    int collapsed = 0;
+    for (uint k = 0; k < per_item && at < end; ++k, at += group) {
+        if (at >= patch_end) {
+            p = patch_of(index_offsets, p, last, 3 * at);
+            patch_start = index_offsets[p] / 3;
+            patch_end = index_offsets[p + 1] / 3;
+            f = patch_factors(factors[p], &collapsed);
+            base = (uint)vertex_offsets[p];
+        }
+        uint t = (uint)(at - patch_start);
+#ifdef PATTERN_TRIANGLE_AT
+        uint3 triangle;
+        if (pattern_triangle_at(f, collapsed, t, &triangle)) {
+            vstore3(triangle + base, at - first_triangle, indices);
+            continue;
+        }
+#endif
+        if (t == 0)
+            pattern_primitives(f, collapsed, indices + 3 * (at - first_triangle), base);
+    }
+}
