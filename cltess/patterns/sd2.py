@@ -69,9 +69,9 @@ HINT_SHIFT = 2
 
 def sd2_hint(f) -> tuple[int, int] | None:
     """(m, phi_m) of a patch's hint slot f[3], or None (no hint, or not a corner)."""
-    if len(f) < 4 or int(f[3]) <= 0:
+    if len(f) < 4 or int(f[3]) == 0:
         return None
-    h = int(f[3])
+    h = abs(int(f[3]))  # stage 2 stores an unused slot negated (kernels/common.h patch_factors)
     m = h & ((1 << HINT_SHIFT) - 1)
     return (m, h >> HINT_SHIFT) if m < 3 else None
 

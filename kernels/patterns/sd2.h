@@ -67,9 +67,10 @@ inline int sd2_shape(int4 f, int *tip)
 #define SD2_HINT_SHIFT 2
 inline int sd2_hint(int4 f, int *m, int *phi)
 {
-    *m = f.s3 & ((1 << SD2_HINT_SHIFT) - 1);
-    *phi = f.s3 >> SD2_HINT_SHIFT;
-    return f.s3 > 0 && *m < 3;
+    int h = abs(f.s3);  /* stage 2 stores an unused slot negated (common.h patch_factors) */
+    *m = h & ((1 << SD2_HINT_SHIFT) - 1);
+    *phi = h >> SD2_HINT_SHIFT;
+    return h > 0 && *m < 3;
 }
 
 /* The tie zone of the fan with tip c (mirror sd2_morph): 1 when in it, with *w the radial
