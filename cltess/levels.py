@@ -109,6 +109,26 @@ def level_factors(function: str, corners, values, depth_map: str = "linear", nea
     return (np.maximum(a, b) * FIXED_ONE).astype(np.int64)
 
 
+def level_hints(function: str, corners, values, depth_map: str = "linear", near: float = 0.0,
+                far: float = 1.0, low: float = 1.0, high: float = 7.0) -> np.ndarray:
+    """(T,) the SD-2 pattern's hint per triangle (kernels/criteria/level.h level_hint,
+    cltess/patterns/sd2.py sd2_hint): ``(phi_m << 2) | m``, m the first corner of the smallest
+    per-vertex factor phi (depth: g of its depth, bound: its bound), 0 for the silhouette."""
+    from .patterns.sd2 import HINT_SHIFT
+    corners = np.asarray(corners, np.int64)
+    values = np.asarray(values, np.float64)[corners]
+    if function == "depth":
+        phi = np.maximum(np.rint(depth_factor(values, depth_map, near, far, low, high) * FIXED_ONE), FIXED_ONE)
+    elif function == "bound":
+        phi = values * FIXED_ONE
+    else:
+        return np.zeros(len(corners), np.int64)
+    phi = phi.astype(np.int64)
+    m = np.argmin(phi, axis=1)
+    smallest = phi[np.arange(len(phi)), m]
+    return np.where((smallest > 0) & (smallest < 1 << 29), (smallest << HINT_SHIFT) | m, 0)
+
+
 def reference_level_factors(scene, request, stage1: np.ndarray) -> tuple[np.ndarray, dict]:
     """The NumPy backend's level-function stage: (T, 4) fixed-point factors of the scene's PN
     triangles from their stage-1 factors ``stage1`` (T, 4) (culled and folded: 0 stays 0), as
@@ -130,4 +150,5 @@ def reference_level_factors(scene, request, stage1: np.ndarray) -> tuple[np.ndar
     out = np.zeros((len(corners), 4), np.int64)
     live = np.asarray(stage1)[:, 0] > 0
     out[live, :3] = fixed[live]
+    out[live, 3] = level_hints(function, corners, values, request.depth_map, near, far, low, high)[live]
     return out.astype(np.int32), stats

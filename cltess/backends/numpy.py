@@ -119,6 +119,7 @@ def _fractional_output(plan, first: int, last: int):
             row = plan.factors[p]
             real[p - first] = row / np.float32(FIXED_ONE)
             factors[p - first] = [odd_segments(x) if x > 0 else 0 for x in row]
+            real[p - first, 3] = factors[p - first, 3] = 0  # slot 3: the SD-2 hint, not an edge
             local = sd2_strip_indices(row)
             strips.append(np.where(local == STRIP_RESTART, local, local + plan.vertex_offsets[p]))
     strips = np.concatenate(strips).astype(np.uint32) if strips else np.zeros(0, np.uint32)

@@ -30,7 +30,7 @@ import numpy as np
 
 from ..strips import STRIP_RESTART
 from .base import Pattern
-from .fractional import locations, odd_segments
+from .fractional import FIXED_ONE, locations, odd_segments
 from .tri_transition import tri_pattern
 
 EYE = np.eye(3, dtype=np.float32)
@@ -61,6 +61,70 @@ def _point(c: int, t: np.float32, s: np.float32) -> np.ndarray:
     return weights
 
 
+#: The hint a level function leaves in a patch's fourth factor slot (docs/sd2.md section 5):
+#: ``(phi_m << HINT_SHIFT) | m``, m the corner of the smallest per-vertex factor phi_m (16.16,
+#: the edge factors being the larger of their ends' phi); 0: no hint.  kernels/patterns/sd2.h.
+HINT_SHIFT = 2
+
+
+def sd2_hint(f) -> tuple[int, int] | None:
+    """(m, phi_m) of a patch's hint slot f[3], or None (no hint, or not a corner)."""
+    if len(f) < 4 or int(f[3]) == 0:
+        return None
+    h = abs(int(f[3]))  # stage 2 stores an unused slot negated (kernels/common.h patch_factors)
+    m = h & ((1 << HINT_SHIFT) - 1)
+    return (m, h >> HINT_SHIFT) if m < 3 else None
+
+
+def sd2_morph(f, c: int) -> tuple[bool, np.float32, np.float32]:
+    """(in the tie zone, w, lam) of the fan with tip c (docs/sd2.md section 5).  w: the radial
+    pattern's weight, ``(F - G) / 1.0`` (F the tip edges' factor, G the base's): 0 at a tie, the
+    zone is w < 1.  lam: the weight of the tie configuration with partner c+1 against partner
+    c+2, ``e2 / (e1 + e2)``, e_k = F - phi_k the distance of base corner k from tying with the
+    tip (1/2 at a triple tie).  Outside the zone, or without a usable hint: (False, 1, 1)."""
+    one = np.float32(1.0)
+    hint = sd2_hint(f)
+    big, base = int(f[c]), int(f[(c + 1) % 3])
+    if hint is None or hint[0] == c or hint[1] > base or big < base or big - base >= FIXED_ONE:
+        return False, one, one
+    m, phi_m = hint
+    e_m, e_other = big - phi_m, big - base
+    e1, e2 = (e_m, e_other) if m == (c + 1) % 3 else (e_other, e_m)
+    w = np.float32(e_other) * np.float32(1.0 / FIXED_ONE)
+    lam = np.float32(e2) / np.float32(e1 + e2) if e1 + e2 > 0 else np.float32(0.5)
+    return True, w, lam
+
+
+def _fan_z(t: np.float32, s: np.float32, w: np.float32, lam: np.float32) -> np.float32:
+    """Corner c+2's weight of the zone's fan vertex at row location t and base location s:
+    ``w t s + (1 - w) (lam max(t + s - 1, 0) + (1 - lam) min(s, t))``: the radial pattern's t s
+    pulled towards the tie configurations with partner c+1 (lines of constant corner c+1 weight
+    through the base points) and c+2 (constant c+2 weight), its Frechet bounds; nondecreasing in
+    s, so rows stay ordered (device: sd2_fan_z, the same operations)."""
+    f32, one, zero = np.float32, np.float32(1.0), np.float32(0.0)
+    radial = f32(t * s)
+    towards_1 = max(f32(f32(t + s) - one), zero)
+    towards_2 = min(s, t)
+    tie = f32(f32(lam * towards_1) + f32(f32(one - lam) * towards_2))
+    return f32(f32(w * radial) + f32(f32(one - w) * tie))
+
+
+def _row_point(c: int, t: np.float32, z: np.float32) -> np.ndarray:
+    """Barycentric point on the row at location t from corner c with corner c+2 weight z."""
+    weights = np.zeros(3, np.float32)
+    weights[c] = np.float32(1.0) - t
+    weights[(c + 1) % 3] = np.float32(t - z)
+    weights[(c + 2) % 3] = z
+    return weights
+
+
+def sd2_grid_corner(f) -> int:
+    """The corner the grid's rows start from: with a hint, m + 1 (the tied pair is m+1, m+2 and
+    the grid is their tie configuration), else 0."""
+    hint = sd2_hint(f)
+    return (hint[0] + 1) % 3 if hint is not None else 0
+
+
 def _ring_uv(f, segments) -> list:
     """(u, v) of the ring points, as kernels/common.h tri_edge_point places them."""
     uv = []
@@ -82,6 +146,11 @@ class _Layout:
         self.ring_size = sum(self.n)
         self.base = [0, self.n[0], self.n[0] + self.n[1]]
         self.shape, self.tip = sd2_shape(self.f)
+        self.zone, self.w, self.lam = False, np.float32(1.0), np.float32(1.0)
+        if self.shape == "grid":
+            self.tip = sd2_grid_corner(f)
+        elif self.shape == "sd2":
+            self.zone, self.w, self.lam = sd2_morph(f, self.tip)
 
     def ring(self, e, k):
         return (self.base[e % 3] + k) % self.ring_size
@@ -98,16 +167,21 @@ class _Layout:
             return self.ring(c + 2, a - i)
         return self.ring_size + (i - 1) * (b - 1) + (j - 1)
 
+    def centre(self, i, j):
+        """The zone's centre vertex of the quad between rows i, i+1 and radial lines j, j+1."""
+        a, b = self.n[self.tip], self.n[(self.tip + 1) % 3]
+        return self.ring_size + (a - 1) * (b - 1) + (i - 1) * b + j
+
     def grid(self, i, j):
-        n = self.n[0]
+        n, g = self.n[0], self.tip
         if i == 0:
-            return self.ring(0, 0)
+            return self.ring(g, 0)
         if j == 0:
-            return self.ring(0, i)
+            return self.ring(g, i)
         if i == n:
-            return self.ring(1, j)
+            return self.ring(g + 1, j)
         if j == i:
-            return self.ring(2, n - i)
+            return self.ring(g + 2, n - i)
         return self.ring_size + (i - 2) * (i - 1) // 2 + (j - 1)
 
 
@@ -122,16 +196,37 @@ def sd2_layout(f) -> tuple[np.ndarray, list[np.ndarray]]:
         c = lay.tip
         a, b = lay.n[c], lay.n[(c + 1) % 3]
         t, s = locations(lay.f[c]), locations(lay.f[(c + 1) % 3])
-        uv += [_point(c, t[i], s[j])[:2] for i in range(1, a) for j in range(1, b)]
-        for j in range(b):
-            strip = [lay.sd2(0, 0)]
-            for i in range(1, a + 1):
-                strip += [lay.sd2(i, j), lay.sd2(i, j + 1)]
-            strips.append(np.array(strip, np.int64))
+        if not lay.zone:
+            uv += [_point(c, t[i], s[j])[:2] for i in range(1, a) for j in range(1, b)]
+            for j in range(b):
+                strip = [lay.sd2(0, 0)]
+                for i in range(1, a + 1):
+                    strip += [lay.sd2(i, j), lay.sd2(i, j + 1)]
+                strips.append(np.array(strip, np.int64))
+        else:
+            # the tie zone: vertices pulled towards the tie configuration, and each quad's centre
+            # sliding on its upper row from corner (i, j+1) (the radial pattern's diagonal) to
+            # (i, j) (the other diagonal, partner c+2) by mu = (1 - w)(1 - lam)
+            w, lam = lay.w, lay.lam
+            z = [[_fan_z(t[i], s[j], w, lam) for j in range(b + 1)] for i in range(a + 1)]
+            uv += [_row_point(c, t[i], z[i][j])[:2] for i in range(1, a) for j in range(1, b)]
+            mu = np.float32(np.float32(1.0) - w) * np.float32(np.float32(1.0) - lam)
+            keep = np.float32(1.0) - mu
+            uv += [_row_point(c, t[i], np.float32(np.float32(keep * z[i][j + 1]) + np.float32(mu * z[i][j])))[:2]
+                   for i in range(1, a) for j in range(b)]
+            for j in range(b):
+                strips.append(np.array([lay.sd2(0, 0), lay.sd2(1, j), lay.sd2(1, j + 1)], np.int64))
+                for i in range(1, a):
+                    A, B, D, E = lay.sd2(i, j), lay.sd2(i + 1, j), lay.sd2(i + 1, j + 1), lay.sd2(i, j + 1)
+                    C = lay.centre(i, j)
+                    strips += [np.array([A, B, C, D, E], np.int64), np.array([E, A, C], np.int64)]
     elif lay.shape == "grid":
         n = lay.n[0]
         t = locations(lay.f[0])
-        uv += [_point(0, t[i], np.float32(j) / np.float32(i))[:2] for i in range(2, n) for j in range(1, i)]
+        if sd2_hint(f) is None:
+            uv += [_point(0, t[i], np.float32(j) / np.float32(i))[:2] for i in range(2, n) for j in range(1, i)]
+        else:  # the tie configuration: corner g+1's weight at the edges' points (docs/sd2.md 5)
+            uv += [_row_point(lay.tip, t[i], np.float32(t[i] - t[i - j]))[:2] for i in range(2, n) for j in range(1, i)]
         for i in range(n):
             strip = []
             for j in range(i + 1, 0, -1):
@@ -172,6 +267,8 @@ def sd2_counts(f) -> tuple[int, int, int]:
         return 0, 0, 0
     if lay.shape == "sd2":
         a, b = lay.n[lay.tip], lay.n[(lay.tip + 1) % 3]
+        if lay.zone:
+            return a * (b + 1) + 1 + (a - 1) * b, b * (4 * a - 3), b * (10 * a - 6)
         return a * (b + 1) + 1, b * (2 * a - 1), b * (2 * a + 2)
     if lay.shape == "grid":
         n = lay.n[0]

@@ -34,6 +34,29 @@ inline float depth_factor(float d, int map, float near, float far, float low, fl
 
 inline int fixed_factor(float r) { return max((int)rint(r * (float)FIXED_ONE), FIXED_ONE); }
 
+/* The per-vertex factor phi (fixed point) whose larger of an edge's two ends is the edge's
+ * factor (depth: g of the depth; bound: the odd whole bound); 0 for the silhouette, whose edge
+ * factor is not of that form. */
+inline int level_vertex_factor(int function, float a, int map, float4 range)
+{
+    if (function == LEVEL_DEPTH)
+        return fixed_factor(depth_factor(a, map, range.s0, range.s1, range.s2, range.s3));
+    return function == LEVEL_BOUND ? (int)a * FIXED_ONE : 0;
+}
+
+/* The SD-2 pattern's hint for a triangle (patterns/sd2.h sd2_hint; docs/sd2.md section 5):
+ * (phi_m << 2) | m, m the corner of the smallest phi (the first such); 0 without phi. */
+inline int level_hint(int function, const float *value, int map, float4 range)
+{
+    int phi[3], m = 0;
+    for (int c = 0; c < 3; ++c)
+        phi[c] = level_vertex_factor(function, value[c], map, range);
+    for (int c = 1; c < 3; ++c)
+        if (phi[c] < phi[m])
+            m = c;
+    return phi[m] > 0 && phi[m] < (1 << 29) ? (phi[m] << 2) | m : 0;
+}
+
 /* Edge factor (fixed point) from its ends' values a, b (levels, or odd whole bound factors).
  * depth: g(min(a, b)) = max(g(a), g(b)), g falling; silhouette: high where the classes differ. */
 inline int level_edge_factor(int function, float a, float b, int map, float4 range)

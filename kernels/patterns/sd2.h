@@ -61,6 +61,68 @@ inline int sd2_shape(int4 f, int *tip)
     return f.s1 == f.s2 || f.s0 == f.s1 ? SD2_FAN : SD2_TRANSITION;
 }
 
+/* The hint a level function leaves in the fourth factor slot (docs/sd2.md section 5; mirror
+ * cltess/patterns/sd2.py HINT_SHIFT): (phi_m << SD2_HINT_SHIFT) | m, m the corner of the
+ * smallest per-vertex factor phi_m; 0: none.  Returns 1 with *m, *phi when there is one. */
+#define SD2_HINT_SHIFT 2
+inline int sd2_hint(int4 f, int *m, int *phi)
+{
+    int h = abs(f.s3);  /* stage 2 stores an unused slot negated (common.h patch_factors) */
+    *m = h & ((1 << SD2_HINT_SHIFT) - 1);
+    *phi = h >> SD2_HINT_SHIFT;
+    return h > 0 && *m < 3;
+}
+
+/* The tie zone of the fan with tip c (mirror sd2_morph): 1 when in it, with *w the radial
+ * pattern's weight (F - G) / 1.0 and *lam the weight of the tie with partner c+1,
+ * e2 / (e1 + e2), e_k = F - phi_k. */
+inline int sd2_morph(int4 f, int c, float *w, float *lam)
+{
+    int m, phi_m;
+    int big = factor_of(f, c), base = factor_of(f, (c + 1) % 3);
+    *w = 1.0f;
+    *lam = 1.0f;
+    if (!sd2_hint(f, &m, &phi_m) || m == c || phi_m > base || big < base || big - base >= FIXED_ONE)
+        return 0;
+    int e_m = big - phi_m, e_other = big - base;
+    int e1 = m == (c + 1) % 3 ? e_m : e_other, e2 = m == (c + 1) % 3 ? e_other : e_m;
+    *w = (float)e_other * (1.0f / (float)FIXED_ONE);
+    *lam = e1 + e2 > 0 ? (float)e2 / (float)(e1 + e2) : 0.5f;
+    return 1;
+}
+
+/* Corner c+2's weight of the zone's fan vertex at row location t, base location s (mirror
+ * _fan_z, the same operations): w t s + (1 - w) (lam max(t + s - 1, 0) + (1 - lam) min(s, t)). */
+inline float sd2_fan_z(float t, float s, float w, float lam)
+{
+    float radial = t * s;
+    float towards_1 = fmax((t + s) - 1.0f, 0.0f);
+    float towards_2 = fmin(s, t);
+    float a = lam * towards_1;
+    float b = (1.0f - lam) * towards_2;
+    float tie = a + b;
+    float x = w * radial;
+    float y = (1.0f - w) * tie;
+    return x + y;
+}
+
+/* Barycentric point on the row at location t from corner c with corner c+2 weight z. */
+inline float3 sd2_row_point(int c, float t, float z)
+{
+    float w[3];
+    w[c] = 1.0f - t;
+    w[(c + 1) % 3] = t - z;
+    w[(c + 2) % 3] = z;
+    return (float3)(w[0], w[1], w[2]);
+}
+
+/* The corner the grid's rows start from: m + 1 with a hint, else 0. */
+inline int sd2_grid_corner(int4 f)
+{
+    int m, phi;
+    return sd2_hint(f, &m, &phi) ? (m + 1) % 3 : 0;
+}
+
 /* Location of point i of an edge of factor fixed, from its start. */
 inline float sd2_location(int fixed, int i)
 {
@@ -93,6 +155,9 @@ inline float3 pattern_edge_point(int e, edge_param t) { return tri_edge_point(e,
 inline int pattern_rows(int4 f)
 {
     int tip, shape = sd2_shape(f, &tip);
+    float w, lam;
+    if (shape == SD2_FAN)  /* in the tie zone, the quads' centres: a - 1 rows more */
+        return (sd2_segments(f, tip) - 1) * (sd2_morph(f, tip, &w, &lam) ? 2 : 1);
     return shape == SD2_FAN ? sd2_segments(f, tip) - 1
          : shape == SD2_GRID ? max(sd2_segments(f, 0) - 2, 0)
          : shape == SD2_TRANSITION ? transition_rows(sd2_whole(f)) : 0;
@@ -101,6 +166,8 @@ inline int pattern_rows(int4 f)
 inline int pattern_row(int4 f, int j)
 {
     int tip, shape = sd2_shape(f, &tip);
+    if (shape == SD2_FAN)  /* centre rows (j >= a): b centres, b + 1 steps */
+        return sd2_segments(f, (tip + 1) % 3) + (j >= sd2_segments(f, tip) ? 1 : 0);
     return shape == SD2_FAN ? sd2_segments(f, (tip + 1) % 3)
          : shape == SD2_GRID ? j + 1 : transition_row(sd2_whole(f), j);
 }
@@ -108,10 +175,32 @@ inline int pattern_row(int4 f, int j)
 inline float3 pattern_row_point(int4 f, int j, int i)
 {
     int tip, shape = sd2_shape(f, &tip);
-    if (shape == SD2_FAN)
-        return sd2_point(tip, sd2_location(factor_of(f, tip), j), sd2_location(factor_of(f, (tip + 1) % 3), i));
-    if (shape == SD2_GRID)
-        return sd2_point(0, sd2_location(f.s0, j + 1), (float)i / (float)(j + 1));
+    if (shape == SD2_FAN) {
+        int big = factor_of(f, tip), base = factor_of(f, (tip + 1) % 3);
+        float w, lam;
+        if (!sd2_morph(f, tip, &w, &lam))
+            return sd2_point(tip, sd2_location(big, j), sd2_location(base, i));
+        int a = sd2_segments(f, tip);
+        if (j < a) {
+            float t = sd2_location(big, j);
+            return sd2_row_point(tip, t, sd2_fan_z(t, sd2_location(base, i), w, lam));
+        }
+        /* the centre of quad (r, i - 1), sliding on row r from (r, i) to (r, i - 1) by mu */
+        int r = j - (a - 1);
+        float t = sd2_location(big, r);
+        float mu = (1.0f - w) * (1.0f - lam);
+        float keep = 1.0f - mu;
+        float right = keep * sd2_fan_z(t, sd2_location(base, i), w, lam);
+        float left = mu * sd2_fan_z(t, sd2_location(base, i - 1), w, lam);
+        return sd2_row_point(tip, t, right + left);
+    }
+    if (shape == SD2_GRID) {
+        int m, phi;
+        if (!sd2_hint(f, &m, &phi))
+            return sd2_point(0, sd2_location(f.s0, j + 1), (float)i / (float)(j + 1));
+        float t = sd2_location(f.s0, j + 1);  /* the tie configuration (docs/sd2.md section 5) */
+        return sd2_row_point((m + 1) % 3, t, t - sd2_location(f.s0, j + 1 - i));
+    }
     return transition_row_point(sd2_whole(f), j, i);
 }
 
@@ -163,14 +252,22 @@ inline uint sd2_vertex(int4 n, int c, int i, int j)
     return (uint)(n.s0 + n.s1 + n.s2 + (i - 1) * (b - 1) + (j - 1));
 }
 
-/* Local number of grid vertex (i, j): row i (i + 1 points) parallel to edge 1, point j from edge 0. */
-inline uint grid_vertex(int4 n, int i, int j)
+/* Local number of the tie zone's centre of the quad between rows i, i+1 and radial lines j, j+1. */
+inline uint sd2_centre(int4 n, int c, int i, int j)
+{
+    int a = factor_of(n, c), b = factor_of(n, (c + 1) % 3);
+    return (uint)(n.s0 + n.s1 + n.s2 + (a - 1) * (b - 1) + (i - 1) * b + j);
+}
+
+/* Local number of grid vertex (i, j): row i (i + 1 points) parallel to the edge opposite
+ * corner g, point j from edge g. */
+inline uint grid_vertex(int4 n, int g, int i, int j)
 {
     int m = n.s0;
-    if (i == 0) return sd2_ring(n, 0, 0);
-    if (j == 0) return sd2_ring(n, 0, i);
-    if (i == m) return sd2_ring(n, 1, j);
-    if (j == i) return sd2_ring(n, 2, m - i);
+    if (i == 0) return sd2_ring(n, g, 0);
+    if (j == 0) return sd2_ring(n, g, i);
+    if (i == m) return sd2_ring(n, g + 1, j);
+    if (j == i) return sd2_ring(n, g + 2, m - i);
     return (uint)(n.s0 + n.s1 + n.s2 + (i - 2) * (i - 1) / 2 + (j - 1));
 }
 
@@ -181,7 +278,33 @@ inline void sd2_walk(int4 f, int collapsed, __private strip_writer *w)
 {
     int tip, shape = sd2_shape(f, &tip);
     int4 n = sd2_whole(f);
-    if (shape == SD2_FAN) {
+    float weight, lam;
+    if (shape == SD2_FAN && sd2_morph(f, tip, &weight, &lam)) {
+        /* the tie zone: per radial pair the tip's triangle, then each quad A B D E with its
+         * centre C as two strips [A, B, C, D, E] and [E, A, C] */
+        int a = factor_of(n, tip), b = factor_of(n, (tip + 1) % 3);
+        for (int j = 0; j < b; ++j) {
+            strip_put(w, sd2_vertex(n, tip, 0, 0));
+            strip_put(w, sd2_vertex(n, tip, 1, j));
+            strip_put(w, sd2_vertex(n, tip, 1, j + 1));
+            strip_end(w);
+            for (int i = 1; i < a; ++i) {
+                uint A = sd2_vertex(n, tip, i, j), B = sd2_vertex(n, tip, i + 1, j);
+                uint D = sd2_vertex(n, tip, i + 1, j + 1), E = sd2_vertex(n, tip, i, j + 1);
+                uint C = sd2_centre(n, tip, i, j);
+                strip_put(w, A);
+                strip_put(w, B);
+                strip_put(w, C);
+                strip_put(w, D);
+                strip_put(w, E);
+                strip_end(w);
+                strip_put(w, E);
+                strip_put(w, A);
+                strip_put(w, C);
+                strip_end(w);
+            }
+        }
+    } else if (shape == SD2_FAN) {
         int a = factor_of(n, tip), b = factor_of(n, (tip + 1) % 3);
         for (int j = 0; j < b; ++j) {
             strip_put(w, sd2_vertex(n, tip, 0, 0));
@@ -192,12 +315,13 @@ inline void sd2_walk(int4 f, int collapsed, __private strip_writer *w)
             strip_end(w);
         }
     } else if (shape == SD2_GRID) {
+        int g = sd2_grid_corner(f);
         for (int i = 0; i < n.s0; ++i) {
             for (int j = i + 1; j > 0; --j) {
-                strip_put(w, grid_vertex(n, i + 1, j));
-                strip_put(w, grid_vertex(n, i, j - 1));
+                strip_put(w, grid_vertex(n, g, i + 1, j));
+                strip_put(w, grid_vertex(n, g, i, j - 1));
             }
-            strip_put(w, grid_vertex(n, i + 1, 0));
+            strip_put(w, grid_vertex(n, g, i + 1, 0));
             strip_end(w);
         }
     } else if (shape == SD2_TRANSITION) {
@@ -227,8 +351,10 @@ inline int sd2_closed_counts(int4 f, uint *triangles, uint *strip_indices)
     int tip, shape = sd2_shape(f, &tip);
     if (shape == SD2_FAN) {
         uint a = (uint)sd2_segments(f, tip), b = (uint)sd2_segments(f, (tip + 1) % 3);
-        *triangles = b * (2 * a - 1);
-        *strip_indices = b * (2 * a + 2);
+        float w, lam;
+        int zone = sd2_morph(f, tip, &w, &lam);
+        *triangles = zone ? b * (4 * a - 3) : b * (2 * a - 1);
+        *strip_indices = zone ? b * (10 * a - 6) : b * (2 * a + 2);
         return 1;
     }
     if (shape == SD2_GRID) {

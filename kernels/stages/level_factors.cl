@@ -19,5 +19,6 @@ __kernel void level_factors(__global const int *corners, __global const float *l
     int f[3];
     for (int e = 0; e < 3; ++e)
         f[e] = level_edge_factor(function, value[e], value[(e + 1) % 3], map, range);
-    factors[patch_base + p] = (int4)(f[0], f[1], f[2], 0);
+    /* slot 3: the pattern's hint, which corner would tie with the tip next (docs/sd2.md 5) */
+    factors[patch_base + p] = (int4)(f[0], f[1], f[2], level_hint(function, value, map, range));
 }

@@ -48,6 +48,16 @@ def random_fixed_factors(rng, count, high=40):
     whole = rng.random(count) < 0.2
     factors[whole, :3] = (2 * (factors[whole, :3] // (2 * FIXED_ONE)) + 1) * FIXED_ONE
     factors[rng.random(count) < 0.05, :3] = FIXED_ONE
+    # a level function's records (edge = the larger of its ends' phi, the hint in slot 3; docs/sd2.md
+    # section 5), most in the tie zone (tip edges less than 1.0 above the base), ties included
+    from cltess.patterns.sd2 import HINT_SHIFT
+    for p in np.flatnonzero(rng.random(count) < 0.3):
+        top = int(rng.integers(FIXED_ONE, high * FIXED_ONE))
+        phi = [top, max(top - int(rng.choice([0, rng.integers(0, FIXED_ONE), rng.integers(0, 3 * FIXED_ONE)])), FIXED_ONE),
+               max(top - int(rng.integers(0, 4 * FIXED_ONE)), FIXED_ONE)]
+        phi = [phi[k] for k in rng.permutation(3)]
+        m = int(np.argmin(phi))
+        factors[p] = [max(phi[e], phi[(e + 1) % 3]) for e in range(3)] + [(phi[m] << HINT_SHIFT) | m]
     factors[rng.random(count) < 0.1] = 0
     return factors
 

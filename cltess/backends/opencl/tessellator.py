@@ -434,7 +434,10 @@ class Tessellator:
                 parts.append(PlanPart(kind, PATTERNS[pattern], lo, hi - lo, data))
         arrays = {name: cl_array.to_device(self.queue, getattr(host, name))
                   for name in ("objects", "factors", "vertex_offsets", "index_offsets")}
+        if host.strip_offsets is not None:  # a strip pattern's strips (emit_strips) come along
+            arrays["strip_offsets"] = cl_array.to_device(self.queue, host.strip_offsets)
         return Plan(host.name, host.num_patches, parts, num_vertices=host.num_vertices,
+                    num_strip_indices=host.num_strip_indices,
                     num_indices=host.num_indices, stats=dict(host.stats), events={},
                     started=time.perf_counter(), request=host.request,
                     _host={name: getattr(host, name) for name in ("factors", "vertex_offsets", "index_offsets")},
@@ -849,7 +852,8 @@ class Plan:
         for part in fixed:
             lo, hi = max(first, part.base) - first, min(last, part.base + part.count) - first
             if lo < hi:
-                rows = factors[lo:hi]
+                rows = factors[lo:hi].copy()
+                rows[:, 3] = 0  # slot 3 of a triangle: the SD-2 pattern's hint, not an edge
                 real[lo:hi] = rows / np.float32(FIXED_ONE)
                 whole[lo:hi] = np.where(rows > 0, 2 * ((rows + 2 * FIXED_ONE - 1 + FIXED_ONE) >> 17) - 1, 0)
         return whole, real
@@ -906,7 +910,9 @@ class Plan:
                         [(p.kind.name, p.pattern.name, p.base, p.count) for p in self.parts],
                         [p.data["controls"].get() for p in self.parts], self.objects.get(),
                         self.host_factors(), self._offsets("vertex_offsets"), self._offsets("index_offsets"),
-                        self.num_vertices, self.num_indices, dict(self.stats), self.request)
+                        self.num_vertices, self.num_indices, dict(self.stats), self.request,
+                        self.strip_offsets.get() if self.strip_offsets is not None else None,
+                        self.num_strip_indices)
 
 
 @dataclass
@@ -917,7 +923,7 @@ class HostPlan:
     input, (count, 16, 4) float32 (the Bézier patches, or the PN control points stage 1 made);
     objects (P,) int32; factors (P, 4) int32, final (crack-free, collapsed edges negated); vertex_offsets and
     index_offsets (P+1,) uint64 with the totals last; stats as Plan.stats; request: what it
-    was planned for.
+    was planned for; strip_offsets and num_strip_indices as Plan's (None, 0 without strips).
     """
 
     name: str
@@ -932,3 +938,5 @@ class HostPlan:
     num_indices: int
     stats: dict
     request: Request
+    strip_offsets: np.ndarray | None = None  # a strip pattern's (P+1,) strip index offsets (Plan's)
+    num_strip_indices: int = 0
