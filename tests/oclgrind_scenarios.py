@@ -349,15 +349,6 @@ SCENARIOS = {
     "esc_levels_strips": esc_levels_strips,
 }
 
-#: Scenarios whose normals the default device (Intel's CPU runtime) gets wrong, and why: their
-#: meshes are compared with the simulator's without the normals there (test_results_match_pocl).
-NORMALS_WRONG_ON_INTEL_CPU = {
-    "esc_levels_strips":
-        "Intel's CPU runtime gives ESC's stage 4 wrong normals in vector lanes 1-3 (every patch p with "
-        "p % 4 != 0 of a multi-patch scene; main at 0d4ca32 too; right with CL_CONFIG_USE_VECTORIZER=False, "
-        "on PoCL and in Oclgrind): not traced (notes/issue14.md).",
-}
-
 #: Scenarios whose tessellation is then measured on the device (Tessellator.verify,
 #: kernels/stages/verify.cl): both kinds, collapsed edges, culled patches.
 VERIFIED = ("rational_sphere", "pn_icosphere", "mixed_culled")

@@ -28,7 +28,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import pyopencl as cl
 import pytest
 
 import oclgrind_scenarios as scenarios
@@ -247,9 +246,7 @@ def test_results_match_pocl(oclgrind, tmp_path_factory, tessellator, pass_name):
         got = load_npz(run.out_dir / f"{name}.npz")
         for field in ("factors", "triangles", "positions", "uv", "patch_ids", "object_ids"):
             assert np.array_equal(getattr(got, field), getattr(expected, field)), f"{name}: {field}"
-        intel_cpu = "Intel" in tessellator.device.platform.name and tessellator.device.type & cl.device_type.CPU
-        if not (intel_cpu and name in scenarios.NORMALS_WRONG_ON_INTEL_CPU):  # the reason is there
-            np.testing.assert_allclose(got.normals, expected.normals, rtol=0, atol=1e-6, err_msg=name)
+        np.testing.assert_allclose(got.normals, expected.normals, rtol=0, atol=1e-6, err_msg=name)
         for rows, base in scenarios.ROWS_IN_PARALLEL.items():  # stages/vertex_rows.cl: bitwise stage 4's
             if base == name and rows in run.results:
                 by_rows = load_npz(run.out_dir / f"{rows}.npz")

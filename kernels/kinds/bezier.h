@@ -111,8 +111,14 @@ inline float3 limit_normal(const float4 b[16], float u, float v, float4 s, float
 }
 
 /* Unit normal at (u, v), given B, B_u, B_v there: t_u x t_v, or at a collapsed edge its limit
- * (limit_normal); if that vanishes too, a step towards the centre; else +z. */
-inline float3 surface_normal(const float4 b[16], float u, float v, float4 s, float4 s_u, float4 s_v)
+ * (limit_normal); if that vanishes too, a step towards the centre; else +z.
+ * ALWAYS_INLINE works around Intel's CPU OpenCL runtime (2026.22): in ESC's stage 4 (only there)
+ * its vectoriser left this float3-returning call to a vector variant and read lane k's result
+ * 12 bytes (a packed float3) after lane k-1's where it was written 16 bytes (a float3's size)
+ * after: lane k got floats 3k .. 3k+2 of the padded results, so every patch but one in 8 had
+ * scrambled normals (docs/esc.md, "Normals on Intel's CPU runtime";
+ * tests/test_pattern_normals.py).  Returning a float4 also avoided it. */
+ALWAYS_INLINE float3 surface_normal(const float4 b[16], float u, float v, float4 s, float4 s_u, float4 s_v)
 {
     int ok;
     float3 n = tangent_cross(s, s_u, s_v, &ok);
