@@ -46,15 +46,7 @@ def test_points_are_bitwise_the_per_patch_kernels(tessellator, by_points, monkey
     scene = load_scene(SCENES / name)
     per_patch = opencl.Tessellator(tessellator.device, work="patch")
     expected, got = per_patch.tessellate(scene, **options), by_points.tessellate(scene, **options)
-    if options.get("pattern") == "esc" and not np.array_equal(expected.normals,
-                                                              per_patch.tessellate(scene, **options).normals):
-        # The per-patch kernel's ESC normals on Intel's CPU runtime differ from run to run, some
-        # zero (on main too; PoCL: unit, deterministic, equal to the point kernel's): there
-        # only the point kernel's normals being unit is checked.
-        same(expected, got, normals=False)
-        assert np.allclose(np.linalg.norm(got.normals, axis=1), 1, atol=1e-5)
-    else:
-        same(expected, got)
+    same(expected, got)
 
 
 def test_points_in_batches(tessellator, by_points):
