@@ -175,10 +175,15 @@ def main() -> int:
                         run_cli([str(scene), orient, *base], env)  # fills the warm cache
                     walls.append(run_cli([str(scene), orient, *base], env))
                     cpu.setdefault((orient, state), []).append(CPU_SECONDS[-1])
-                    if args.baseline and state == "cold":  # the baseline has no cache: cold only
-                        baseline.append(run_cli([str(scene), orient, *base],
-                                                dict(env, PYTHONPATH=str(Path(args.baseline).resolve()))))
-                        cpu.setdefault((orient, "baseline"), []).append(CPU_SECONDS[-1])
+                    if args.baseline:  # its own caches: a fresh one (cold), its warm one (warm)
+                        base_cache = folder / (f"cache-baseline-{orient}-{len(walls)}" if state == "cold"
+                                               else "cache-baseline")
+                        base_env = dict(env, PYTHONPATH=str(Path(args.baseline).resolve()),
+                                        CLTESS_SCENE_CACHE=str(base_cache))
+                        if state == "warm" and not baseline:
+                            run_cli([str(scene), orient, *base], base_env)  # fills its warm cache
+                        baseline.append(run_cli([str(scene), orient, *base], base_env))
+                        cpu.setdefault((orient, f"{state}, baseline"), []).append(CPU_SECONDS[-1])
                     if orient == "--orient" and state == "warm":  # the peers, in the same loop
                         peers.append(run_peer(out.stat().st_size, peer, env))
                         cpu.setdefault(("peer", "write"), []).append(CPU_SECONDS[-1])
@@ -186,7 +191,7 @@ def main() -> int:
                         cpu.setdefault(("peer", "imports"), []).append(CPU_SECONDS[-1])
                 rows[(orient, state)] = walls
                 if baseline:
-                    rows[(orient, "baseline")] = baseline
+                    rows[(orient, f"{state}, baseline")] = baseline
                 if peers:
                     rows[("peer", "write")] = peers
                     rows[("peer", "imports")] = imports
