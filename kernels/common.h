@@ -188,6 +188,12 @@ inline float3 tri_edge_point(int e, edge_param p)
     return e == 0 ? (float3)(s, t, 0.0f) : e == 1 ? (float3)(0.0f, s, t) : (float3)(t, 0.0f, s);
 }
 
+/* Point i of row j of the uniform triangle grid of n steps: (i / n, j / n, (n - i - j) / n). */
+inline float3 tri_grid_point(int n, int j, int i)
+{
+    return (float3)((float)i / (float)n, (float)j / (float)n, (float)(n - i - j) / (float)n);
+}
+
 /* --- factors ------------------------------------------------------------------------------- */
 
 inline int factor_of(int4 f, int e) { return e == 0 ? f.s0 : e == 1 ? f.s1 : e == 2 ? f.s2 : f.s3; }

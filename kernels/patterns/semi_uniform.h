@@ -53,14 +53,12 @@ inline float3 pattern_edge_point(int e, edge_param t) { return tri_edge_point(e,
 
 inline int pattern_rows(int4 f) { return max(su_size(f) - 2, 0); }
 
-/* Row j (v = j / n) runs from (0, v, 1-v) to (1-v, v, 0) in n - j steps: point i at
- * (i / n, j / n, (n - i - j) / n). */
+/* Row j (v = j / n) runs from (0, v, 1-v) to (1-v, v, 0) in n - j steps. */
 inline int pattern_row(int4 f, int j) { return su_size(f) - j; }
 
 inline float3 pattern_row_point(int4 f, int j, int i)
 {
-    int n = su_size(f);
-    return (float3)((float)i / (float)n, (float)j / (float)n, (float)(n - i - j) / (float)n);
+    return tri_grid_point(su_size(f), j, i);
 }
 #endif
 

@@ -24,14 +24,12 @@ inline float3 pattern_edge_point(int e, edge_param t) { return tri_edge_point(e,
 
 inline int pattern_rows(int4 f) { return max(tri_core(f) - 2, 0); }
 
-/* Row j (v = j / N) runs from (0, v, 1-v) to (1-v, v, 0) in N - j steps: point i at
- * (i / N, j / N, (N - i - j) / N). */
+/* Row j (v = j / N) runs from (0, v, 1-v) to (1-v, v, 0) in N - j steps. */
 inline int pattern_row(int4 f, int j) { return tri_core(f) - j; }
 
 inline float3 pattern_row_point(int4 f, int j, int i)
 {
-    int n = tri_core(f);
-    return (float3)((float)i / (float)n, (float)j / (float)n, (float)(n - i - j) / (float)n);
+    return tri_grid_point(tri_core(f), j, i);
 }
 
 #include "patterns/layout.h"
