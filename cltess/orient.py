@@ -212,8 +212,7 @@ def orient_scene(scene: Scene) -> tuple[Scene, Orientation]:
     report = Orientation()
     patches = scene.patches
     if len(patches):
-        groups = scene_edge_groups(scene)
-        flip, part = orientation_flips(groups, len(patches), 4, *_bezier_samples(patches))
+        flip, part = _bezier_flips(scene)
         _add(report, part)
         if flip.any():
             patches = patches.copy()
@@ -237,6 +236,24 @@ def orient_scene(scene: Scene) -> tuple[Scene, Orientation]:
     if not report.flipped:
         return scene, report
     return Scene(patches, scene.object_ids, scene.camera, scene.name, meshes), report
+
+
+def _bezier_flips(scene: Scene) -> tuple[np.ndarray, Orientation]:
+    """``orientation_flips`` of the scene's Bézier patches; a large scene's are kept in the
+    scene cache (``io.scene_cache.derived``: keyed by the patches and the code that decides)."""
+    from . import scene as scene_module
+    from .crack import adjacency
+    from .io.scene_cache import derived
+    from .surfaces import bezier
+
+    def make():
+        flip, report = orientation_flips(scene_edge_groups(scene), len(scene.patches), 4,
+                                         *_bezier_samples(scene.patches))
+        return {"flip": flip, "counts": np.array([report.flipped, report.components, report.conflicts])}
+
+    sources = [__file__, adjacency.__file__, bezier.__file__, scene_module.__file__]
+    stored = derived(scene, "orientation", sources, make)
+    return stored["flip"], Orientation(*(int(count) for count in stored["counts"]))
 
 
 def _mesh_options(mesh: TriangleMesh) -> dict:

@@ -144,8 +144,18 @@ def edge_groups(patches: np.ndarray) -> EdgeGroups:
 
 def scene_edge_groups(scene) -> EdgeGroups:
     """``edge_groups(scene.patches)``, computed once per scene (``Scene.prepared``): orientation
-    (cltess/orient.py) and the pipeline's Bézier input share it."""
-    return scene.prepared("bezier edge groups", lambda: edge_groups(scene.patches))
+    (cltess/orient.py) and the pipeline's Bézier input share it; a large scene's are kept in
+    the scene cache (``io.scene_cache.derived``: keyed by the patches and this code)."""
+    def make():
+        from ..io.scene_cache import derived
+
+        stored = derived(scene, "edge-groups", [__file__, boundary_curves.__code__.co_filename],
+                         lambda: {field.name: np.asarray(getattr(groups, field.name)) for groups in
+                                  [edge_groups(scene.patches)] for field in dataclasses.fields(EdgeGroups)})
+        return EdgeGroups(**{field.name: stored[field.name] if stored[field.name].ndim else int(stored[field.name])
+                             for field in dataclasses.fields(EdgeGroups)})
+
+    return scene.prepared("bezier edge groups", make)
 
 
 def _grouped(labels: np.ndarray, collapsed: np.ndarray, flipped: np.ndarray, palindrome: np.ndarray,
