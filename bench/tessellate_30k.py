@@ -12,6 +12,13 @@ imports, OpenCL start, parsing, orientation, stages, the file written and fsync'
 * "warm": the same cache again: the patches come from the binary cache;
 * each with the default ``--orient`` and with ``--no-orient``.
 
+Beside them, in the same loop: the *peers*, a child that writes the PLY's number of bytes from
+one NumPy array (``tofile``, fsync, rename onto the last file: the disk's rate as this file
+system gives it) and a child that only starts Python and imports the CLI's modules.  The
+machine is shared, so every row gives the median and the minimum of ``--repeat`` runs, and the
+CPU seconds (user + system, all threads) of the same children, which other processes disturb
+less than the wall clock.
+
 Then the same steps timed one by one in this process (warm kernels), to show where the time
 goes.
 """
@@ -20,6 +27,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -46,37 +54,96 @@ def write_scene(path: Path, copies: int = 960) -> None:
     write_bpt(path, np.concatenate(parts))
 
 
-def run_cli(args: list[str], env: dict) -> float:
+CPU_SECONDS: list = []  # (user + system) CPU seconds of each child run, in run order
+
+
+def run_child(command: list[str], env: dict) -> float:
+    """Wall seconds of a child process; its CPU seconds (user + system, all its threads) are
+    appended to CPU_SECONDS."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     started = time.perf_counter()
-    done = subprocess.run([sys.executable, "-m", "cltess", "tessellate", *args], env=env, capture_output=True,
-                          text=True)
+    done = subprocess.run(command, env=env, capture_output=True, text=True)
     wall = time.perf_counter() - started
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    CPU_SECONDS.append(after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
     if done.returncode:
         sys.exit(done.stderr)
     return wall
 
 
+def run_cli(args: list[str], env: dict) -> float:
+    return run_child([sys.executable, "-m", "cltess", "tessellate", *args], env)
+
+
+#: The peer of the PLY write: the same number of bytes from one NumPy array, ``tofile`` into
+#: a file beside the PLY, fsync'd and renamed onto the last one (what atomic_write does), in
+#: a child process (Python start and NumPy import included, as for the CLI).
+PEER = """
+import os, sys, numpy as np
+data = np.ones(int(sys.argv[1]), np.uint8)
+with open(sys.argv[2] + ".tmp", "wb") as f:
+    data.tofile(f)
+    f.flush()
+    os.fsync(f.fileno())
+os.replace(sys.argv[2] + ".tmp", sys.argv[2])
+"""
+
+
+def run_peer(size: int, path: Path, env: dict) -> float:
+    return run_child([sys.executable, "-c", PEER, str(size), str(path)], env)
+
+
+def run_imports(env: dict) -> float:
+    """Python start and the imports of the CLI's tessellate path, in a child."""
+    return run_child([sys.executable, "-c", "import cltess.cli, cltess.stream, cltess.orient, cltess.io"], env)
+
+
 def steps(scene_path: Path, out: Path, eps: float, device: str | None) -> dict:
-    """The CLI's steps one by one (after a warm-up run of the same), seconds."""
+    """The CLI's steps one by one in this process (run after a warm-up of the same), seconds:
+    each step's calls wrapped in a wall clock (``_timed``)."""
+    import cltess.io.ply as ply
     from cltess.backends.opencl import Tessellator
+    from cltess.backends.opencl import tessellator as module
     from cltess.io import load_scene
     from cltess.orient import orient_scene
     from cltess.stream import tessellate_to_file
 
     tessellator = Tessellator(device)
-    times = {}
-    started = time.perf_counter()
-    scene = load_scene(scene_path)
-    times["load (parse or cache)"] = time.perf_counter() - started
-    started = time.perf_counter()
-    oriented, _ = orient_scene(scene)
-    times["orient"] = time.perf_counter() - started
-    started = time.perf_counter()
-    result = tessellate_to_file(tessellator, oriented, out, eps=eps)
-    times["tessellate + write PLY"] = time.perf_counter() - started
-    times["of which device stages"] = sum(v for k, v in result.stage_ms.items() if k != "total_wall") / 1e3
+    times: dict = {}
+    wrapped = [(module.Tessellator, "plan", "plan: host adjacency, uploads, stages 1-3, totals"),
+               (module.PendingEmit, "result", "wait for stages 4-5"),
+               (ply.PlyWriter, "write_vertices", "PLY vertex records + writes"),
+               (ply.PlyWriter, "write_faces", "PLY face records + writes"),
+               (os, "fsync", "fsync"), (os, "replace", "rename onto the old file")]
+    originals = [(owner, name, getattr(owner, name)) for owner, name, _ in wrapped]
+    for owner, name, label in wrapped:
+        setattr(owner, name, _timed(getattr(owner, name), label, times))
+    try:
+        started = time.perf_counter()
+        scene = load_scene(scene_path)
+        times["load (parse or cache)"] = time.perf_counter() - started
+        started = time.perf_counter()
+        oriented, _ = orient_scene(scene)
+        times["orient (edge groups, shared with plan)"] = time.perf_counter() - started
+        started = time.perf_counter()
+        result = tessellate_to_file(tessellator, oriented, out, eps=eps)
+        times["tessellate + write PLY, in all"] = time.perf_counter() - started
+    finally:
+        for owner, name, original in originals:
+            setattr(owner, name, original)
+    times["device stages (profiling spans)"] = sum(v for k, v in result.stage_ms.items() if k != "total_wall") / 1e3
     times["file MB"] = out.stat().st_size / 1e6
     return times
+
+
+def _timed(function, label: str, times: dict):
+    def timed(*args, **kwargs):
+        started = time.perf_counter()
+        try:
+            return function(*args, **kwargs)
+        finally:
+            times[label] = times.get(label, 0.0) + time.perf_counter() - started
+    return timed
 
 
 def main() -> int:
@@ -96,26 +163,47 @@ def main() -> int:
         out = folder / "out.ply"
         base = ["--eps", str(args.eps), "--no-weld", "-q", "-o", str(out)] + (["--device", args.device] if args.device else [])
         print(f"{scene.name}: {scene.stat().st_size / 1e6:.1f} MB; load average {os.getloadavg()}")
-        rows = {}
+        rows, cpu = {}, {}
+        peer = folder / "peer.bin"
         for orient in ("--orient", "--no-orient"):
             for state in ("cold", "warm"):
-                walls, baseline = [], []
+                walls, baseline, peers, imports = [], [], [], []
                 for _ in range(args.repeat):
                     cache = folder / f"cache-{orient}-{len(walls)}"  # cold: a fresh cache each run
                     env = dict(os.environ, CLTESS_SCENE_CACHE=str(cache if state == "cold" else folder / "cache"))
                     if state == "warm" and not walls:
                         run_cli([str(scene), orient, *base], env)  # fills the warm cache
                     walls.append(run_cli([str(scene), orient, *base], env))
-                    if args.baseline and state == "cold":  # the baseline has no cache: cold only
-                        baseline.append(run_cli([str(scene), orient, *base],
-                                                dict(env, PYTHONPATH=str(Path(args.baseline).resolve()))))
+                    cpu.setdefault((orient, state), []).append(CPU_SECONDS[-1])
+                    if args.baseline:  # its own caches: a fresh one (cold), its warm one (warm)
+                        base_cache = folder / (f"cache-baseline-{orient}-{len(walls)}" if state == "cold"
+                                               else "cache-baseline")
+                        base_env = dict(env, PYTHONPATH=str(Path(args.baseline).resolve()),
+                                        CLTESS_SCENE_CACHE=str(base_cache))
+                        if state == "warm" and not baseline:
+                            run_cli([str(scene), orient, *base], base_env)  # fills its warm cache
+                        baseline.append(run_cli([str(scene), orient, *base], base_env))
+                        cpu.setdefault((orient, f"{state}, baseline"), []).append(CPU_SECONDS[-1])
+                    if orient == "--orient" and state == "warm":  # the peers, in the same loop
+                        peers.append(run_peer(out.stat().st_size, peer, env))
+                        cpu.setdefault(("peer", "write"), []).append(CPU_SECONDS[-1])
+                        imports.append(run_imports(env))
+                        cpu.setdefault(("peer", "imports"), []).append(CPU_SECONDS[-1])
                 rows[(orient, state)] = walls
                 if baseline:
-                    rows[(orient, "baseline")] = baseline
+                    rows[(orient, f"{state}, baseline")] = baseline
+                if peers:
+                    rows[("peer", "write")] = peers
+                    rows[("peer", "imports")] = imports
         size = out.stat().st_size
-        print(f"PLY {size / 1e6:.0f} MB, eps {args.eps}; wall seconds, median [min-max] of {args.repeat}:")
+        print(f"PLY {size / 1e6:.0f} MB, eps {args.eps}; wall seconds, median [min-max] of {args.repeat}; "
+              f"CPU seconds (user + system) of the same runs, median [min]:")
         for (orient, state), walls in rows.items():
-            print(f"  {orient:12} {state:5}: {statistics.median(walls):.2f} [{min(walls):.2f}-{max(walls):.2f}]")
+            spent = cpu[(orient, state)]
+            label = {"write": "tofile + fsync + rename of the PLY's bytes", "imports": "python + the CLI's imports"}.get(
+                state, state) if orient == "peer" else state
+            print(f"  {orient:12} {label:44}: {statistics.median(walls):.2f} [{min(walls):.2f}-{max(walls):.2f}]"
+                  f"   CPU {statistics.median(spent):.2f} [{min(spent):.2f}]")
         os.environ["CLTESS_SCENE_CACHE"] = str(folder / "cache")
         steps(scene, out, args.eps, args.device)  # warm-up
         for name, value in steps(scene, out, args.eps, args.device).items():

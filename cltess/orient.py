@@ -25,9 +25,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .crack.adjacency import edge_groups
+from .crack.adjacency import scene_edge_groups
 from .kinds.pn import mesh_edge_groups
-from .surfaces.bezier import surface_points
+from .surfaces.bezier import bernstein3
 from .scene import Scene, TriangleMesh
 
 __all__ = ["Orientation", "orient_scene", "orientation_flips"]
@@ -53,17 +53,72 @@ class Orientation:
         return {"flipped_patches": self.flipped, "orientation_conflicts": self.conflicts}
 
 
-def orientation_flips(groups, num_patches: int, edges_per_patch: int, triangles: np.ndarray,
-                      patch_of: np.ndarray) -> tuple[np.ndarray, Orientation]:
+def orientation_flips(groups, num_patches: int, edges_per_patch: int, points: np.ndarray,
+                      grid: np.ndarray) -> tuple[np.ndarray, Orientation]:
     """(flip (P,) bool, report): which patches to reverse so that every shared edge is run in
-    opposite directions and every component has a positive signed volume.  triangles (n, 3, 3):
-    a sampling of the patches, facing as they do; patch_of (n,): the patch of each."""
+    opposite directions and every component has a positive signed volume.  points (3, P, S): S
+    samples of each patch (x, y, z rows); grid (T, 3): the triangles over a patch's samples,
+    facing as the patch does."""
     sizes = groups.group_sizes
     pair_start = groups.group_start[:-1][sizes == 2]
     a, b = groups.members[pair_start].astype(np.int64), groups.members[pair_start + 1].astype(np.int64)
     p, q = a // edges_per_patch, b // edges_per_patch
     use = p != q
     p, q, differ = p[use], q[use], (groups.flipped[a] == groups.flipped[b])[use]
+    flip, component, report = _parity_components(num_patches, p, q, differ)
+
+    volume, size = _signed_volumes(points, grid, component, np.where(flip, -1.0, 1.0), report.components)
+    inward = volume < -FLAT * size ** 3  # a flat piece has no outside: left as it is
+    flip ^= inward[component]
+    report.flipped = int(flip.sum())
+    return flip, report
+
+
+def _parity_components(num_patches: int, p: np.ndarray, q: np.ndarray, differ: np.ndarray):
+    """(flip, component, report) of the parity constraints ``flip[q] = flip[p] ^ differ``: each
+    component's smallest patch keeps its orientation and components are numbered in order of
+    their smallest patch (what a breadth-first walk from patch 0, 1, ... gives).
+
+    Vectorised: each patch is two nodes, "kept" (2 p) and "reversed" (2 p + 1); a constraint
+    joins (2 p, 2 q + differ) and (2 p + 1, 2 q + 1 - differ).  The connected components of that
+    doubled graph (``_components``, labelled by their smallest node) are the answer: patch p is
+    reversed when its "kept" node is not in the component of its seed's "kept" node.  Where a
+    patch's two nodes meet (a conflict: a Moebius strip) the breadth-first walk decides
+    (``_parity_walk``), which also counts the conflicting edges."""
+    differ = differ.astype(np.int64)
+    heads = np.concatenate([2 * p, 2 * p + 1])
+    tails = np.concatenate([2 * q + differ, 2 * q + 1 - differ])
+    label = _components(2 * num_patches, heads, tails)
+    kept, reversed_ = label[0::2], label[1::2]
+    if (kept == reversed_).any():
+        return _parity_walk(num_patches, p, q, differ.astype(bool))
+    seed = np.minimum(kept, reversed_)  # 2 s, s the component's smallest patch
+    seeds, component = np.unique(seed, return_inverse=True)
+    report = Orientation(components=len(seeds))
+    return kept != seed, component.ravel().astype(np.int64), report
+
+
+def _components(count: int, heads: np.ndarray, tails: np.ndarray) -> np.ndarray:
+    """(count,) the smallest node of each node's connected component (edges heads[k]-tails[k]):
+    roots hooked onto the smaller root across an edge, then paths shortened to their root, until
+    no edge joins two roots (Shiloach-Vishkin style, all in NumPy)."""
+    label = np.arange(count)
+    while True:
+        a, b = label[heads], label[tails]
+        hooked = label.copy()
+        np.minimum.at(hooked, np.maximum(a, b), np.minimum(a, b))
+        while True:  # pointer jumping: every node to its root
+            jumped = hooked[hooked]
+            if np.array_equal(jumped, hooked):
+                break
+            hooked = jumped
+        if np.array_equal(hooked, label):
+            return label
+        label = hooked
+
+
+def _parity_walk(num_patches: int, p: np.ndarray, q: np.ndarray, differ: np.ndarray):
+    """``_parity_components`` by a breadth-first walk, counting conflicting edges."""
     # adjacency lists (CSR) of the constraint graph, both ways
     heads = np.concatenate([p, q])
     tails = np.concatenate([q, p])
@@ -94,52 +149,61 @@ def orientation_flips(groups, num_patches: int, edges_per_patch: int, triangles:
         report.components += 1
     report.conflicts = conflicts // 2  # each conflicting edge is seen from both sides
 
-    volume, size = _signed_volumes(triangles, component[patch_of], np.where(flip[patch_of], -1.0, 1.0),
-                                   report.components)
-    inward = volume < -FLAT * size ** 3  # a flat piece has no outside: left as it is
-    flip ^= inward[component]
-    report.flipped = int(flip.sum())
-    return flip, report
+    return flip, component, report
 
 
-def _signed_volumes(triangles: np.ndarray, component: np.ndarray, sign: np.ndarray, count: int):
+def _signed_volumes(points: np.ndarray, grid: np.ndarray, component: np.ndarray, sign: np.ndarray,
+                    count: int):
     """((count,) signed volume, (count,) bounding-box diagonal) per component.  The volume: the
-    sum over its triangles (a, b, d), each times sign, of det(a - c, b - c, d - c) / 6 =
-    (det(a, b, d) - c . (a x b + b x d + d x a)) / 6, c the centroid of the component's
-    corners.  Coordinates are taken about the scene's centre first (against cancellation far
-    from the origin)."""
-    points = triangles - triangles.reshape(-1, 3).mean(axis=0)
-    a, b, d = points[:, 0], points[:, 1], points[:, 2]
-    determinant = np.einsum("ij,ij->i", a, np.cross(b, d)) * sign
-    twice_area = (np.cross(a, b) + np.cross(b, d) + np.cross(d, a)) * sign[:, None]
+    sum over its patches' triangles (a, b, d) (``grid`` over ``points``, each patch's times its
+    sign) of det(a - c, b - c, d - c) / 6 = (det(a, b, d) - c . (a x b + b x d + d x a)) / 6, c
+    the centroid of the component's triangle corners.  Coordinates are taken about the scene's
+    centre first (against cancellation far from the origin).  The sums are taken per patch,
+    then per component (bincount)."""
+    points = points - points.reshape(3, -1).mean(axis=1)[:, None, None]
+    a, b, d = (points[:, :, grid[:, k]] for k in range(3))  # (3, P, T) each
+    b_x_d = _cross(b, d)
+    determinant = (a * b_x_d).sum(axis=(0, 2)) * sign
+    twice_area = (_cross(a, b) + b_x_d + _cross(d, a)).sum(axis=2) * sign
+    corner_sum = (a + b + d).sum(axis=2)
 
     def per_component(values):
         return np.bincount(component, values, minlength=count)
 
-    corners = per_component(np.full(len(points), 3.0))
-    centre = np.stack([per_component(points[..., axis].sum(axis=1)) for axis in range(3)], axis=1)
+    corners = per_component(np.full(len(component), 3.0 * len(grid)))
+    centre = np.stack([per_component(corner_sum[axis]) for axis in range(3)], axis=1)
     centre /= np.maximum(corners, 1)[:, None]
-    area = np.stack([per_component(twice_area[:, axis]) for axis in range(3)], axis=1)
+    area = np.stack([per_component(twice_area[axis]) for axis in range(3)], axis=1)
+    # bounding boxes of the samples: patches sorted by component, reduced per run
+    order = np.argsort(component, kind="stable")
+    present, start = np.unique(component[order], return_index=True)
     low, high = np.full((count, 3), np.inf), np.full((count, 3), -np.inf)
-    np.minimum.at(low, component, points.min(axis=1))
-    np.maximum.at(high, component, points.max(axis=1))
+    if len(order):
+        low[present] = np.minimum.reduceat(points.min(axis=2).T[order], start)
+        high[present] = np.maximum.reduceat(points.max(axis=2).T[order], start)
     size = np.linalg.norm(np.where(np.isfinite(high - low), high - low, 0), axis=1)
     return (per_component(determinant) - (centre * area).sum(axis=1)) / 6, size
 
 
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a x b of (3, n) arrays (rows x, y, z), as np.cross computes each component."""
+    return np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
 def _bezier_samples(patches: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(triangles, patch_of): each patch sampled on a VOLUME_SAMPLES^2 grid, two triangles per
-    cell, counter-clockwise in (u, v), so facing the t_u x t_v side."""
+    """(points (3, P, S), grid (T, 3)): each patch sampled on a VOLUME_SAMPLES^2 grid, two
+    triangles per cell, counter-clockwise in (u, v), so facing the t_u x t_v side.  The points
+    are one matrix product: B(v_s) B(u_s) per sample s against each patch's 16 control points."""
     n = VOLUME_SAMPLES
     u, v = np.meshgrid(np.linspace(0, 1, n), np.linspace(0, 1, n))
     u, v = u.ravel(), v.ravel()
     cells = np.array([(j * n + i, j * n + i + 1, (j + 1) * n + i + 1, (j + 1) * n + i)
                       for j in range(n - 1) for i in range(n - 1)])
     grid = np.concatenate([cells[:, [0, 1, 2]], cells[:, [0, 2, 3]]])
-    count = len(patches)
-    points = surface_points(patches, np.repeat(np.arange(count), len(u)), np.tile(u, count), np.tile(v, count))
-    triangles = points.reshape(count, len(u), 3)[:, grid]
-    return triangles.reshape(-1, 3, 3), np.repeat(np.arange(count), len(grid))
+    weights = (bernstein3(v)[:, :, None] * bernstein3(u)[:, None, :]).reshape(len(u), 16)  # [s, 4 j + i]
+    controls = np.asarray(patches, np.float64).reshape(len(patches), 16, 4).transpose(2, 0, 1)  # (4, P, 16)
+    homogeneous = controls @ weights.T  # (4, P, S)
+    return homogeneous[:3] / homogeneous[3:], grid
 
 
 def orient_scene(scene: Scene) -> tuple[Scene, Orientation]:
@@ -148,8 +212,7 @@ def orient_scene(scene: Scene) -> tuple[Scene, Orientation]:
     report = Orientation()
     patches = scene.patches
     if len(patches):
-        groups = edge_groups(patches)
-        flip, part = orientation_flips(groups, len(patches), 4, *_bezier_samples(patches))
+        flip, part = _bezier_flips(scene)
         _add(report, part)
         if flip.any():
             patches = patches.copy()
@@ -161,8 +224,8 @@ def orient_scene(scene: Scene) -> tuple[Scene, Orientation]:
             continue
         corners = mesh.vertices[mesh.faces].astype(np.float32)
         groups, _ = mesh_edge_groups(corners)
-        flip, part = orientation_flips(groups, mesh.num_faces, 3, corners.astype(np.float64),
-                                       np.arange(mesh.num_faces))
+        flip, part = orientation_flips(groups, mesh.num_faces, 3, corners.astype(np.float64).transpose(2, 0, 1),
+                                       np.array([[0, 1, 2]]))
         _add(report, part)
         if flip.any():
             faces = mesh.faces.copy()
@@ -173,6 +236,24 @@ def orient_scene(scene: Scene) -> tuple[Scene, Orientation]:
     if not report.flipped:
         return scene, report
     return Scene(patches, scene.object_ids, scene.camera, scene.name, meshes), report
+
+
+def _bezier_flips(scene: Scene) -> tuple[np.ndarray, Orientation]:
+    """``orientation_flips`` of the scene's Bézier patches; a large scene's are kept in the
+    scene cache (``io.scene_cache.derived``: keyed by the patches and the code that decides)."""
+    from . import scene as scene_module
+    from .crack import adjacency
+    from .io.scene_cache import derived
+    from .surfaces import bezier
+
+    def make():
+        flip, report = orientation_flips(scene_edge_groups(scene), len(scene.patches), 4,
+                                         *_bezier_samples(scene.patches))
+        return {"flip": flip, "counts": np.array([report.flipped, report.components, report.conflicts])}
+
+    sources = [__file__, adjacency.__file__, bezier.__file__, scene_module.__file__]
+    stored = derived(scene, "orientation", sources, make)
+    return stored["flip"], Orientation(*(int(count) for count in stored["counts"]))
 
 
 def _mesh_options(mesh: TriangleMesh) -> dict:

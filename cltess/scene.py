@@ -28,6 +28,7 @@ edge  curve     boundary control points, in order      factor of
 from __future__ import annotations
 
 import copy
+import math
 import os
 import stat
 from dataclasses import dataclass, field
@@ -141,6 +142,13 @@ def boundary_curves(patches: np.ndarray) -> np.ndarray:
     )
 
 
+def _cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a x b of two 3-vectors, each component as ``np.cross`` computes it (a1 b2 - a2 b1, ...)."""
+    a0, a1, a2 = a.tolist()
+    b0, b1, b2 = b.tolist()
+    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
+
+
 @dataclass
 class Camera:
     """A pinhole camera for screen-space tolerances (docs/design.md section 7)."""
@@ -155,15 +163,20 @@ class Camera:
     far: float = 1.0e4
 
     def view_matrix(self) -> np.ndarray:
-        """World -> camera (4, 4); the camera looks down its -z axis, right-handed."""
-        forward = np.asarray(self.target, float) - np.asarray(self.eye, float)
-        forward /= np.linalg.norm(forward)
-        right = np.cross(forward, np.asarray(self.up, float))
-        right /= np.linalg.norm(right)
-        true_up = np.cross(right, forward)
+        """World -> camera (4, 4); the camera looks down its -z axis, right-handed.
+
+        Once per frame, so on Python floats: the same IEEE operations as ``np.cross`` and
+        ``np.linalg.norm`` (sqrt of the vector's dot with itself), bitwise the same matrix
+        (tests/test_session.py), at a fraction of their call overhead."""
+        eye = np.asarray(self.eye, float)
+        forward = np.asarray(self.target, float) - eye
+        forward /= math.sqrt(forward.dot(forward))
+        right = _cross3(forward, np.asarray(self.up, float))
+        right /= math.sqrt(right.dot(right))
+        true_up = _cross3(right, forward)
         view = np.eye(4)
         view[0, :3], view[1, :3], view[2, :3] = right, true_up, -forward
-        view[:3, 3] = -view[:3, :3] @ np.asarray(self.eye, float)
+        view[:3, 3] = -view[:3, :3] @ eye
         return view
 
     def pixel_size_at_unit_depth(self) -> float:

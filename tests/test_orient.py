@@ -125,3 +125,33 @@ def test_cli_orient_option_refuses_a_value(capsys, tmp_path):
                  str(tmp_path / "cup.ply")])
     assert code == 2 and "--orient" in capsys.readouterr().err
     assert not any(tmp_path.iterdir())
+
+
+def test_a_large_scenes_orientation_and_edge_groups_come_back_from_the_cache(tmp_path, rng, monkeypatch):
+    """io.scene_cache.derived: the second scene with the same patches gets the same flips,
+    report and edge groups (every field, dtype included) from the cache, without deciding
+    again; other patches are another key."""
+    import dataclasses
+
+    import cltess.orient as orient
+    from cltess.crack.adjacency import EdgeGroups, scene_edge_groups
+    from cltess.io import scene_cache
+
+    monkeypatch.setenv("CLTESS_SCENE_CACHE", str(tmp_path))
+    monkeypatch.setattr(scene_cache, "MIN_BYTES", 0)
+    teapot = load_scene(SCENES / "teapot.bez")
+    messy = reversed_u(teapot, rng.random(teapot.num_patches) < 0.5)
+    first, report = orient_scene(messy)
+    assert report.flipped and list(tmp_path.glob("*-orientation-*.npz"))
+    calls = []
+    monkeypatch.setattr(orient, "orientation_flips", lambda *a: calls.append(a))
+    again, report_again = orient_scene(reversed_u(messy, np.zeros(messy.num_patches, bool)))
+    assert not calls and report_again == report and np.array_equal(again.patches, first.patches)
+    cached = scene_edge_groups(Scene(messy.patches, messy.object_ids))
+    fresh = edge_groups(messy.patches)
+    for field in dataclasses.fields(EdgeGroups):
+        a, b = getattr(cached, field.name), getattr(fresh, field.name)
+        assert type(a) is type(b) and np.asarray(a).dtype == np.asarray(b).dtype and np.array_equal(a, b), field.name
+    with pytest.raises(TypeError):  # not in the cache: orientation_flips (the spy) is asked
+        orient_scene(reversed_u(teapot, np.zeros(teapot.num_patches, bool)))
+    assert calls

@@ -124,11 +124,11 @@ def test_normals_at_collapsed_edges_far_from_the_origin(tessellator, centre):
 def test_a_scene_is_prepared_once_and_cannot_change_under_its_cache(tessellator, monkeypatch):
     """Adjacency and uploads are cached on the scene (the benchmark found them dominating end
     to end); the arrays they come from are read-only, so the cache cannot go stale."""
-    from cltess.kinds import bezier
+    from cltess.crack import adjacency  # the Bézier kind's groups: adjacency.scene_edge_groups
 
     calls = []
-    real = bezier.edge_groups
-    monkeypatch.setattr(bezier, "edge_groups", lambda patches: calls.append(1) or real(patches))
+    real = adjacency.edge_groups
+    monkeypatch.setattr(adjacency, "edge_groups", lambda patches: calls.append(1) or real(patches))
     scene = load_scene(SCENES / "teapot.bez")
     first = tessellator.tessellate(scene, eps=0.01)
     second = tessellator.tessellate(scene, eps=0.002)

@@ -102,3 +102,24 @@ def test_session_refuses_what_it_cannot_do(tessellator, tea_table):
         session.tessellate(eps=0.1, pixels=1.0)
     with pytest.raises(ValueError, match="eps must be"):
         session.tessellate(eps=-1.0)
+
+
+def test_view_matrix_is_bitwise_numpys_cross_and_norm():
+    """Camera.view_matrix runs on Python floats (once per frame); it must be the same bits as
+    the np.cross / np.linalg.norm formulation, or every screen-space tolerance moves."""
+    def reference(camera):
+        forward = np.asarray(camera.target, float) - np.asarray(camera.eye, float)
+        forward /= np.linalg.norm(forward)
+        right = np.cross(forward, np.asarray(camera.up, float))
+        right /= np.linalg.norm(right)
+        view = np.eye(4)
+        view[0, :3], view[1, :3], view[2, :3] = right, np.cross(right, forward), -forward
+        view[:3, 3] = -view[:3, :3] @ np.asarray(camera.eye, float)
+        return view
+
+    rng = np.random.default_rng(15)
+    for _ in range(2000):
+        scale = 10.0 ** rng.uniform(-3, 4, 3)
+        camera = Camera(eye=rng.normal(size=3) * scale[0], target=rng.normal(size=3) * scale[1],
+                        up=rng.normal(size=3) * scale[2])
+        assert reference(camera).tobytes() == camera.view_matrix().tobytes()

@@ -29,7 +29,7 @@ from ..scene import boundary_curves
 #: their magnitude of each other: float64 roundings, far below float32's 6e-8.
 COLLAPSED_RELATIVE = 1e-13
 
-__all__ = ["EdgeGroups", "edge_groups", "merge_edge_groups", "crack_free_factors"]
+__all__ = ["EdgeGroups", "edge_groups", "scene_edge_groups", "merge_edge_groups", "crack_free_factors"]
 
 
 @dataclass
@@ -140,6 +140,22 @@ def edge_groups(patches: np.ndarray) -> EdgeGroups:
     groups = _grouped(inverse.ravel(), collapsed, flipped, palindrome, edges_per_patch=4)
     groups.collapsed_edges = collapsed
     return groups
+
+
+def scene_edge_groups(scene) -> EdgeGroups:
+    """``edge_groups(scene.patches)``, computed once per scene (``Scene.prepared``): orientation
+    (cltess/orient.py) and the pipeline's Bézier input share it; a large scene's are kept in
+    the scene cache (``io.scene_cache.derived``: keyed by the patches and this code)."""
+    def make():
+        from ..io.scene_cache import derived
+
+        stored = derived(scene, "edge-groups", [__file__, boundary_curves.__code__.co_filename],
+                         lambda: {field.name: np.asarray(getattr(groups, field.name)) for groups in
+                                  [edge_groups(scene.patches)] for field in dataclasses.fields(EdgeGroups)})
+        return EdgeGroups(**{field.name: stored[field.name] if stored[field.name].ndim else int(stored[field.name])
+                             for field in dataclasses.fields(EdgeGroups)})
+
+    return scene.prepared("bezier edge groups", make)
 
 
 def _grouped(labels: np.ndarray, collapsed: np.ndarray, flipped: np.ndarray, palindrome: np.ndarray,

@@ -1,6 +1,9 @@
 """A binary cache of parsed patch files (issue 15): a large ``.bpt`` / ``.bez`` file read
 again is loaded as the ``.npy`` of its patches, keyed by a hash of its bytes (so an edited file
-is a new key, never a stale hit).
+is a new key, never a stale hit).  What the host derives from a large scene's patches (the
+Bézier edge groups, the orientation) is kept the same way (``derived``), keyed by a hash of the
+patches' bytes *and of the source files of the code that derives it*, so that an edited module
+is a new key too.
 
 Where: ``$CLTESS_SCENE_CACHE`` (a folder; ``0`` or ``off``: no cache), else
 ``$XDG_CACHE_HOME/cltess/scenes`` or ``~/.cache/cltess/scenes``.  Only files of at least
@@ -11,6 +14,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import zipfile
 from pathlib import Path
 from typing import Callable
 
@@ -67,3 +71,38 @@ def read_patch_file(path, kind: str, fast: Callable[[bytes], np.ndarray | None],
         return patches if patches is not None else slow(_Lines(str(path), _decode(path, data)))
 
     return cached_patches(data, kind, parse)
+
+
+def derived(scene, what: str, sources: list, make: Callable[[], dict]) -> dict:
+    """``make()`` (a dict of NumPy arrays), or the arrays a previous ``make()`` stored for a
+    scene with the same patches, derived by the same source files (``sources``: paths).  Scenes
+    whose patches take less than ``MIN_BYTES`` are not cached (they take milliseconds)."""
+    folder = cache_folder() if scene.patches.nbytes >= MIN_BYTES else None
+    if folder is None:
+        return make()
+    digest = hashlib.blake2b(scene.prepared("patches digest", lambda: _digest([scene.patches])).encode(),
+                             digest_size=20)
+    for source in sources:
+        digest.update(Path(source).read_bytes())
+    entry = folder / f"{digest.hexdigest()}-{what}-v{VERSION}.npz"
+    try:
+        with np.load(entry, allow_pickle=False) as stored:
+            return {name: stored[name] for name in stored.files}
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile):
+        pass
+    arrays = make()
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with atomic_write(entry, "wb") as handle:
+            np.savez(handle, **arrays)
+    except OSError:
+        pass
+    return arrays
+
+
+def _digest(arrays) -> str:
+    digest = hashlib.blake2b(digest_size=20)
+    for array in arrays:
+        digest.update(str((array.dtype.str, array.shape)).encode())
+        digest.update(np.ascontiguousarray(array).data)
+    return digest.hexdigest()

@@ -207,12 +207,12 @@ class _Numbers:
             return None
         if len(values) != len(start) or not np.isfinite(values).all():
             return None
-        newlines = np.flatnonzero(newline)
-        line = np.searchsorted(newlines, start)  # physical line (0-based) of each token
+        newlines_before = np.cumsum(newline, dtype=np.int32 if len(chars) < 2**31 else np.int64)
+        line = newlines_before[start]  # physical line (0-based) of each token (a token is no newline)
         per_line = np.bincount(line)
         lines = np.flatnonzero(per_line)
         if commas:
-            commas_per_line = np.bincount(np.searchsorted(newlines, np.flatnonzero(comma)),
+            commas_per_line = np.bincount(newlines_before[np.flatnonzero(comma)],
                                           minlength=len(per_line))[:len(per_line)]
             if commas_per_line.sum() != np.count_nonzero(comma):  # a comma on a line of no token
                 return None

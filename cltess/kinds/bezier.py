@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..criteria.zheng_sederberg import zs_factors
-from ..crack.adjacency import edge_groups
+from ..crack.adjacency import scene_edge_groups
 from ..patterns import QUAD_TRANSITION
 from ..scene import device_patches
 from ..surfaces import bezier as surface
@@ -29,7 +29,7 @@ class BezierKind(PatchKind):
 
     def prepare(self, scene, sharp_edges="straight"):
         return KindInput(device_patches(scene.patches), scene.object_ids,
-                         edge_groups(scene.patches))
+                         scene_edge_groups(scene))
 
     def reference_factors(self, source, tolerance, max_factor):
         patches = np.asarray(source, np.float64).reshape(-1, 4, 4, 4)

@@ -680,6 +680,7 @@ class PendingEmit:
         generation = buffers.generation
 
         def read_back() -> dict:
+            plan.enqueue_host_factors()  # with the output's copies or maps: one wait for all
             host = buffers.read_back(arrays.num_vertices, arrays.num_triangles)
             host["factors"], host["real_factors"] = plan.output_factors(first, last)
             return host
@@ -777,8 +778,9 @@ class OutputBuffers:
         """Unmap the host views of the last generation (before the device writes the buffers
         again, as OpenCL asks).  On a CPU device the views still show the buffers' memory, which
         the next generation overwrites; the buffers live as long as a view of them does."""
-        if self._maps:
-            cl.wait_for_events([m.release(self.queue) for m in self._maps])
+        if self._maps:  # enqueued, not waited for: the queue is in order, so before the writes
+            for memory_map in self._maps:
+                memory_map.release(self.queue)
             self._maps.clear()
 
     def _pinned(self, name, dtype, shape, capacity) -> np.ndarray:
@@ -859,9 +861,18 @@ class Plan:
         return whole, real
 
     def host_factors(self) -> np.ndarray:
-        if "factors" not in self._host:
-            self._host["factors"] = self.factors.get()
+        self.enqueue_host_factors()
+        pending = self._host.pop("factors pending", None)
+        if pending is not None:
+            pending.wait()
         return self._host["factors"]
+
+    def enqueue_host_factors(self) -> None:
+        """Start the factors' copy to the host without waiting (``host_factors`` waits)."""
+        if "factors" not in self._host:
+            self._host["factors"] = np.empty(self.factors.shape, self.factors.dtype)
+            self._host["factors pending"] = cl.enqueue_copy(self.factors.queue, self._host["factors"],
+                                                            self.factors.data, is_blocking=False)
 
     def _offsets(self, which: str) -> np.ndarray:
         if which not in self._host:  # read back only when a range is asked of a partial batch

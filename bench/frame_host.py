@@ -1,0 +1,142 @@
+"""Issue 15, the host side of a frame: wall time per frame against device time, side by side
+with another checkout (e.g. main before a change), children interleaved.
+
+    python bench/frame_host.py [--device NAME] [--frames 20] [--repeat 3] [--scenes all]
+                               [--grid] [--baseline SOURCE_TREE] [--json out.json]
+
+Each child process (this tree, then ``PYTHONPATH=SOURCE_TREE`` for the baseline, alternating
+``--repeat`` times) runs ``bench/frame_loop.py``'s frame loop: a ``cltess.Session`` per suite
+scene at 0.5 px, ``--frames`` cameras on a circle (after one warm-up pass over them), and per
+frame records
+
+* device ms: the sum of the stages' OpenCL profiling spans;
+* "on device": wall ms of ``session.tessellate(camera=...)``, until the stages are done and the
+  output is on the device;
+* "host arrays": wall ms of ``session.tessellate(camera=...).fetch()``, until the caller holds
+  host arrays (a mapping on a CPU device, a copy through page-locked memory on a GPU).
+
+Per scene the report gives, for each tree, the median over frames, then the *smallest* of the
+``--repeat`` children's medians (the machine is shared: the least disturbed run), and the
+ratio wall / device of the same child.  ``--grid`` adds ``frame_loop.py``'s one-thread NumPy
+grid against a session frame with host arrays (10k .. 10M triangles; this tree only).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+
+
+def child(args) -> dict:
+    sys.path.insert(0, str(HERE))
+    import warnings
+
+    warnings.simplefilter("ignore")
+    import frame_loop as fl
+    import cltess
+    from cltess.backends.opencl import Tessellator
+    from cltess.bench.suite import device_info, resolve_scenes
+
+    tessellator = Tessellator(args.device)
+    rows = []
+    for key in resolve_scenes(args.scenes):
+        scene = fl.suite_scene(key)
+        session = cltess.Session(scene, tessellator=tessellator, pixels=fl.PIXELS)
+        path = list(fl.orbit(scene.camera, args.frames))
+        for camera in path:  # warm-up: builds, uploads, buffers at their size
+            session.tessellate(camera=camera).fetch()
+        resident, held, device = [], [], []
+        for camera in path:
+            started = time.perf_counter()
+            frame = session.tessellate(camera=camera)
+            resident.append((time.perf_counter() - started) * 1e3)
+            device.append(fl.device_ms(frame))
+        for camera in path:
+            started = time.perf_counter()
+            session.tessellate(camera=camera).fetch()
+            held.append((time.perf_counter() - started) * 1e3)
+        rows.append({"scene": key, "triangles": frame.num_triangles, "device_ms": statistics.median(device),
+                     "resident_ms": statistics.median(resident), "host_ms": statistics.median(held)})
+    record = {"device": device_info(tessellator.device), "rows": rows, "cltess": cltess.__file__}
+    if args.grid:
+        sizes = [(1, 13), (10, 13), (100, 13), (1000, 13)]
+        record["grid"] = fl.grid_sizes(tessellator, sizes, 3)
+    return record
+
+
+def run_child(argv: list[str], tree: Path | None) -> dict:
+    env = dict(os.environ)
+    if tree is not None:
+        env["PYTHONPATH"] = str(tree)
+    done = subprocess.run([sys.executable, __file__, "--child", *argv], env=env, capture_output=True, text=True)
+    if done.returncode:
+        sys.exit(done.stderr)
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--device")
+    parser.add_argument("--frames", type=int, default=20)
+    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--scenes", nargs="*", default=["all"])
+    parser.add_argument("--grid", action="store_true", help="also the one-thread NumPy grid (this tree only)")
+    parser.add_argument("--baseline", metavar="SOURCE_TREE")
+    parser.add_argument("--json")
+    parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.child:
+        print(json.dumps(child(args), default=float))
+        return 0
+    argv = ["--frames", str(args.frames), "--scenes", *args.scenes] + (["--device", args.device] if args.device else [])
+    trees = {"this": None}
+    if args.baseline:
+        trees["baseline"] = Path(args.baseline).resolve()
+    runs = {name: [] for name in trees}
+    load_before = os.getloadavg()
+    for k in range(args.repeat):
+        for name, tree in trees.items():
+            grid = ["--grid"] if args.grid and name == "this" and k == 0 else []
+            runs[name].append(run_child(argv + grid, tree))
+    device = runs["this"][0]["device"]
+    for name in trees:
+        print(f"{name}: cltess from {runs[name][0]['cltess']}")
+    print(f"device: {device.get('name', device)}; load average before {load_before}, after {os.getloadavg()}; "
+          f"{args.frames} frames, best of {args.repeat} children per tree (median per frame, ms)")
+    header = f"{'scene':20} {'triangles':>10}"
+    for name in trees:
+        header += f" | {name + ' device':>14} {'on device':>10} {'ratio':>6} {'host arr.':>10} {'ratio':>6}"
+    print(header)
+    result = {"device": device, "load": [load_before, os.getloadavg()], "command": " ".join(sys.argv), "scenes": []}
+    for index, row in enumerate(runs["this"][0]["rows"]):
+        line = f"{row['scene']:20} {row['triangles']:>10,}"
+        entry = {"scene": row["scene"], "triangles": row["triangles"]}
+        for name in trees:
+            best = min((run["rows"][index] for run in runs[name]), key=lambda r: r["host_ms"])
+            line += (f" | {best['device_ms']:>14.3f} {best['resident_ms']:>10.3f} {best['resident_ms'] / best['device_ms']:>5.2f}x"
+                     f" {best['host_ms']:>10.3f} {best['host_ms'] / best['device_ms']:>5.2f}x")
+            entry[name] = best
+        print(line)
+        result["scenes"].append(entry)
+    if args.grid:
+        grid = runs["this"][0]["grid"]
+        print("one-thread NumPy grid against a session frame with host arrays (this tree, ms):")
+        for g in grid:
+            print(f"  {g['triangles']:>11,} triangles: NumPy {g['numpy_ms']:9.2f}  cltess frame {g['session_host_ms']:8.2f}"
+                  f" (device {g['session_device_ms']:7.2f}, host/device {g['session_host_ms'] / g['session_device_ms']:.2f}x)"
+                  f"  NumPy/cltess {g['numpy_ms'] / g['session_host_ms']:6.1f}x")
+        result["grid"] = grid
+    if args.json:
+        Path(args.json).write_text(json.dumps(result, indent=1, default=float) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
