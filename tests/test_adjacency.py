@@ -2,8 +2,6 @@
 the exact sphere, hand-made grids and random re-orderings of grids."""
 from __future__ import annotations
 
-import time
-
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -257,14 +255,12 @@ def test_random_grids(nx, ny, seed):
     assert groups.reversed_pairs == flips
 
 
-def test_100k_patches_fast():
-    side = 316  # ~100k patches, ~200k shared edges
-    patches = grid(side, side)
-    start = time.perf_counter()
-    groups = edge_groups(patches)
-    elapsed = time.perf_counter() - start
+def test_100k_patches():
+    """A grid of ~100k patches (~200k shared edges) groups every shared edge; its speed is
+    measured in cltess bench's host adjacency figure, not here."""
+    side = 316
+    groups = edge_groups(grid(side, side))
     assert groups.shared == 2 * (side - 1) * side
-    assert elapsed < 5.0, f"edge_groups on {len(patches)} patches took {elapsed:.2f} s"
 
 
 def test_merged_groups_of_two_kinds_keep_each_kinds_groups(rng):

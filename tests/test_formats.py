@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import json
-import time
 from pathlib import Path
 
 import numpy as np
@@ -53,12 +52,9 @@ def test_teapot_bpt_equals_bez():
     assert bpt[0, 1, 0].tolist() == [1.3375, 0.0, 2.53125, 1.0]
 
 
-def test_bigguy_loads_fast():
-    start = time.perf_counter()
+def test_bigguy_loads():
     scene = load_scene(SCENES / "bigguy.bez")
-    elapsed = time.perf_counter() - start
     assert scene.num_patches == 3570
-    assert elapsed < 2.0, f"bigguy.bez took {elapsed:.2f} s"  # ~0.1 s here
     assert scene.patches[0, 0, 0].tolist() == [-0.294095001667, -0.598564997381, -0.671400683916, 1.0]
 
 
