@@ -57,7 +57,10 @@ RECORDS_PER_ITEM = 4
 #: vertex (stages/vertex_points.cl), stage 5 per patch; "point" a work-item per output vertex and
 #: per output triangle (stages/vertex_points.cl, stages/triangles.cl: consecutive work-items
 #: write consecutive records).  All write the same bits.
-WORK_DISTRIBUTIONS = ("patch", "rows", "vertex", "point")
+#: "vertex-prep" and "point-prep": the same, with each visible patch's kind_patch made once per
+#: frame (stages/prepared_points.cl prepare_patches, into a scratch buffer) and stage 4's
+#: work-items copying it instead of re-running kind_load at every patch change (issue 15, GPUs).
+WORK_DISTRIBUTIONS = ("patch", "rows", "vertex", "point", "vertex-prep", "point-prep")
 #: The default per device type, chosen by bench/frame_loop.py (bench/RESULTS.md, "Issue 15:
 #: kernels"): CPUs keep a patch per work-item (the point kernels replay forward differencing
 #: per vertex: more arithmetic, which a CPU pays); GPUs a work-item per vertex and triangle.
@@ -133,6 +136,8 @@ class Tessellator:
         self.context = cl.Context([self.device])
         self.queue = cl.CommandQueue(self.context, properties=cl.command_queue_properties.PROFILING_ENABLE)
         self.programs = Programs.of(self.context)
+        self._prepared = None  # work="*-prep": the prepared patches' scratch buffer (_prepared_points)
+        self._kind_patch_sizes: dict = {}
 
     @property
     def per_item(self) -> int:
@@ -530,7 +535,8 @@ class Tessellator:
         V = stop - start (written into ``out`` when given), and the events.  rows_per_patch:
         work-items per patch of stages/vertex_rows.cl (0: one per patch, stages/vertices.cl;
         None: as ``work``).  work: "patch", "rows" (with ``MAX_ROWS_PER_PATCH``), "vertex" or
-        "point" (stages/vertex_points.cl, a work-item per vertex); None: the Tessellator's ``work``."""
+        "point" (stages/vertex_points.cl, a work-item per vertex), "vertex-prep" or "point-prep"
+        (stages/prepared_points.cl: the patches prepared first); None: the Tessellator's ``work``."""
         out = self._vertex_arrays(vertex_range[1] - vertex_range[0]) if out is None else out
         first, last = patch_range
         if vertex_range[1] == vertex_range[0] or last <= first:
@@ -543,7 +549,10 @@ class Tessellator:
         work = work or self.work
         if rows_per_patch is None and work == "rows":
             rows_per_patch = MAX_ROWS_PER_PATCH
-        if rows_per_patch is None and work in ("vertex", "point"):  # work-items past the part's vertices return
+        if rows_per_patch is None and work in ("vertex-prep", "point-prep"):
+            event = self._prepared_points(controls, factors, vertex_offsets, patch_objects, vertex_range, first, last,
+                                          forward_differencing, kind, patch_base, pattern, out)
+        elif rows_per_patch is None and work in ("vertex", "point"):  # work-items past the part's vertices return
             event = self.programs.kernel("vertex_points", kind=kind, pattern=pattern)(
                 self.queue, _record_groups(vertex_range[1] - vertex_range[0], self.per_item), (WORK_GROUP,),
                 *arguments, np.uint32(self.per_item), *(a.data for a in out.values()))
@@ -554,7 +563,33 @@ class Tessellator:
         else:
             event = self.programs.kernel("vertices", kind=kind, pattern=pattern)(
                 self.queue, _global_size(last - first), None, *arguments, *(a.data for a in out.values()))
-        return out, [event]
+        return out, list(event) if isinstance(event, tuple) else [event]
+
+    def _prepared_points(self, controls, factors, vertex_offsets, patch_objects, vertex_range, first, last,
+                         forward_differencing, kind, patch_base, pattern, out) -> cl.Event:
+        """Stage 4 by vertex from prepared patches (stages/prepared_points.cl): prepare_patches
+        writes patches first .. last-1's kind_patch to a scratch buffer (kept, grown as needed;
+        the queue is in order, so a later batch's prepare waits for this batch's reads), then
+        prepared_points writes the vertices.  Returns the last event (the profiling span of
+        stage 4 runs from the first enqueued to the last)."""
+        program = dict(kind=kind, pattern=pattern)
+        size = self._kind_patch_sizes.get((kind.name, pattern.header))
+        if size is None:  # sizeof(kind_patch) as the device compiler lays it out
+            answer = cl_array.empty(self.queue, 1, np.uint32)
+            self.programs.kernel("prepared_points", "kind_patch_size", **program)(self.queue, (1,), None, answer.data)
+            size = self._kind_patch_sizes[kind.name, pattern.header] = int(answer.get()[0])
+        needed = max(1, last - first) * size
+        if self._prepared is None or self._prepared.size < needed:
+            self._prepared = cl.Buffer(self.context, cl.mem_flags.READ_WRITE, needed + needed // 4)
+        prepare = self.programs.kernel("prepared_points", "prepare_patches", **program)(
+            self.queue, _global_size(last - first), None, controls.data, vertex_offsets.data, np.uint32(first),
+            np.uint32(last - first), np.uint32(patch_base), self._prepared)
+        points = self.programs.kernel("prepared_points", **program)(
+            self.queue, _record_groups(vertex_range[1] - vertex_range[0], self.per_item), (WORK_GROUP,),
+            self._prepared, factors.data, vertex_offsets.data, patch_objects.data, np.uint32(first),
+            np.uint32(last - first), np.uint64(vertex_range[0]), np.int32(forward_differencing),
+            np.uint32(self.per_item), *(a.data for a in out.values()))
+        return prepare, points
 
     def stage_indices(self, factors, vertex_offsets, index_offsets, index_range, patch_range,
                       kind=BEZIER, out=None, work: str | None = None):
@@ -570,7 +605,7 @@ class Tessellator:
             return triangles, []
         arguments = (factors.data, vertex_offsets.data, index_offsets.data, np.uint32(first),
                      np.uint32(last - first), np.uint64(index_range[0]))
-        if (work or self.work) == "point":  # work-items past the part's triangles stop
+        if (work or self.work) in ("point", "point-prep"):  # work-items past the part's triangles stop
             event = self.programs.kernel("triangles", pattern=_pattern(kind))(
                 self.queue, _record_groups(n // 3, self.per_item), (WORK_GROUP,), *arguments,
                 np.uint32(self.per_item), triangles.data)
