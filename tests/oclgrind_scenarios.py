@@ -398,6 +398,14 @@ POINTS = {"uniform_by_points": "uniform", "many_patches_by_points": "many_patche
           "collapsed_bottom_direct_by_points": "collapsed_bottom_direct", "collapsed_lid_by_points": "collapsed_lid",
           "mixed_culled_by_points": "mixed_culled", "esc_by_points": "esc",
           "many_patches_batched_by_points": ("many_patches", 4096)}  # batches: first_patch > 0
+#: The same with stage 4 from prepared patches (Tessellator(work="point-prep"):
+#: stages/prepared_points.cl prepare_patches and prepared_points; culled patches not prepared,
+#: forward differencing and direct, two kinds, batches); also in POINTS (bitwise checks).
+PREPARED_POINTS = {"uniform_by_prepared_points": "uniform", "pn_icosphere_by_prepared_points": "pn_icosphere",
+                   "collapsed_bottom_direct_by_prepared_points": "collapsed_bottom_direct",
+                   "mixed_culled_by_prepared_points": "mixed_culled", "esc_by_prepared_points": "esc",
+                   "many_patches_batched_by_prepared_points": ("many_patches", 4096)}
+POINTS.update(PREPARED_POINTS)
 #: Scenarios of silhouette refinement (cltess/backends/opencl/silhouette.py): a scene and the
 #: refiner's options, one frame from the eye (x, y, z); every per-frame kernel
 #: (silhouette_alpha, silhouette_levels, crack_free, counts, silhouette_vertices, indices).
@@ -511,7 +519,7 @@ def run_scenario(name: str, tessellator, out_dir: Path) -> dict:
         base, cap = POINTS[name] if isinstance(POINTS[name], tuple) else (POINTS[name], None)
         scene, options = SCENARIOS[base]()
         saved = tessellator.work
-        tessellator.work = "point"  # before the plan: its programs are built before any buffer
+        tessellator.work = "point-prep" if name in PREPARED_POINTS else "point"  # before the plan: its programs are built before any buffer
         try:
             if cap is None:
                 plan = tessellator.plan(scene, **options)
