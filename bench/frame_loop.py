@@ -237,8 +237,14 @@ def output_digest(tess) -> str:
 
 
 #: The side-by-side table's variants: a work distribution, "/N": N records per work-item of the
-#: record kernels (Tessellator.records_per_item; without: RECORDS_PER_ITEM).
-VARIANTS = ["patch", "rows", "vertex", "point", "point/1", "point/16"]
+#: record kernels (Tessellator.records_per_item; without: RECORDS_PER_ITEM), ":direct": stage 4
+#: by direct evaluation (forward_differencing=False; bitwise other bits than with it, so its
+#: "same bits" is among the ":direct" variants of the scene).
+VARIANTS = ["patch", "rows", "vertex", "point", "point/1", "point/16", "vertex-prep", "point-prep"]
+#: The GPU comparison of issue 15 (stage 4 from prepared patches), forward differencing on and off.
+GPU_VARIANTS = ["patch", "vertex", "point", "point/16", "vertex-prep", "point-prep", "point-prep/16",
+                "patch:direct", "vertex:direct", "point/16:direct", "vertex-prep:direct", "point-prep:direct",
+                "point-prep/16:direct"]
 
 
 def work_variants(tessellator, scenes, repeat: int, band: dict, works=VARIANTS) -> list[dict]:
@@ -248,9 +254,11 @@ def work_variants(tessellator, scenes, repeat: int, band: dict, works=VARIANTS) 
         for name, scene, request in scenes:
             for work in works:
                 say(f"work distributions: {name}, {work}")
-                tessellator.work, _, per_item = work.partition("/")
+                spec, _, evaluation = work.partition(":")
+                tessellator.work, _, per_item = spec.partition("/")
                 tessellator.records_per_item = int(per_item) if per_item else None
-                session = cltess.Session(scene, tessellator=tessellator, **request)
+                options = dict(request, forward_differencing=False) if evaluation == "direct" else request
+                session = cltess.Session(scene, tessellator=tessellator, **options)
                 first = session.tessellate().fetch()  # builds, uploads; its bits
                 digest, size, triangles = output_digest(first), output_bytes(first), first.num_triangles
                 del first
@@ -294,7 +302,8 @@ def variants_report(rows: list[dict], band: dict) -> list[str]:
              "| scene | triangles | MB written | work | stages 1-5 ms | stage 3 ms | stage 4 ms | stage 5 ms | "
              "GB/s | % of fill | same bits |", "|---|---|---|---|---|---|---|---|---|---|---|"]
     for row in rows:
-        peers = {r["digest"] for r in rows if r["scene"] == row["scene"]}
+        direct = row["work"].endswith(":direct")
+        peers = {r["digest"] for r in rows if r["scene"] == row["scene"] and r["work"].endswith(":direct") == direct}
         lines.append(f"| {row['scene']} | {row['triangles']:,} | {row['bytes'] / 1e6:.1f} | {row['work']} | "
                      f"{row['device_ms']:.3f} | {row['counts_ms']:.3f} | {row['vertices_ms']:.3f} | "
                      f"{row['indices_ms']:.3f} | {row['bytes'] / (row['device_ms'] / 1e3) / 1e9:.1f} | "
@@ -442,14 +451,18 @@ def main(argv=None) -> int:
     parser.add_argument("--json", help="write the record here too")
     parser.add_argument("--work", nargs="*", default=VARIANTS,
                         help=f"work distributions of the side-by-side table ({', '.join(WORK_DISTRIBUTIONS)}; "
-                             f"'point/N': N records per work-item; default: {' '.join(VARIANTS)})")
+                             f"'point/N': N records per work-item; ':direct' suffix: no forward differencing; "
+                             f"'gpu': {' '.join(GPU_VARIANTS)}; default: {' '.join(VARIANTS)})")
     parser.add_argument("--variants-only", action="store_true",
                         help="bandwidth and the work distributions side by side only (no frame loop, no NumPy grid)")
     args = parser.parse_args(argv)
+    args.work = [w for work in args.work for w in (GPU_VARIANTS if work == "gpu" else [work])]
     for work in args.work:
-        name, _, per_item = work.partition("/")
-        if name not in WORK_DISTRIBUTIONS or (per_item and not per_item.isdigit()):
-            parser.error(f"--work {work}: expected one of {', '.join(WORK_DISTRIBUTIONS)}, optionally /N")
+        spec, _, evaluation = work.partition(":")
+        name, _, per_item = spec.partition("/")
+        if name not in WORK_DISTRIBUTIONS or (per_item and not per_item.isdigit()) or evaluation not in ("", "direct"):
+            parser.error(f"--work {work}: expected one of {', '.join(WORK_DISTRIBUTIONS)}, optionally /N, "
+                         "optionally :direct")
     tessellator = Tessellator(args.device)
     record = {"device": device_info(tessellator.device), "machine": machine_info(), "frames": args.frames,
               "command": " ".join(sys.argv), "date": time.strftime("%Y-%m-%d %H:%M:%S %z"),
