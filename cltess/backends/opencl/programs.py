@@ -33,6 +33,7 @@ STAGE_AXES = {
     "vertex_rows": ("kind", "pattern"),  # stage 4 a work-item per row (Tessellator(work="rows"))
     "vertex_points": ("kind", "pattern"),  # stage 4 a work-item per vertex (Tessellator(work="point"))
     "triangles": ("pattern",),  # stage 5 a work-item per triangle (Tessellator(work="point"))
+    "offsets": ("pattern",),  # stage 3 in one launch (Tessellator.fused_offsets)
     "prepared_points": ("kind", "pattern"),  # stage 4 per vertex from prepared patches (work="*-prep")
     "verify": ("kind",),  # on request only (Tessellator.verify), so not in STAGES
     # silhouette refinement per frame (silhouette.py; they include criteria/silhouette.h)

@@ -67,6 +67,24 @@ WORK_DISTRIBUTIONS = ("patch", "rows", "vertex", "point", "vertex-prep", "point-
 DEFAULT_WORK = {"gpu": "point", "other": "patch"}
 
 
+#: Stage 3 in one launch per range of patches (stages/offsets.cl: counts and the scan by one
+#: work-group) up to this many patches; more go through the counts kernel and pyopencl.scan.
+FUSED_OFFSETS_MAX_PATCHES = 1 << 16
+#: The fused launch's work-group size at most (a power of two; less where the device says so).
+FUSED_OFFSETS_GROUP = 1024
+
+
+def default_fused_offsets(device: cl.Device) -> bool:
+    """Stage 3 by stages/offsets.cl: ``CLTESS_FUSED_OFFSETS`` (0 or 1) if set, else on GPUs
+    (one work-group: a GPU saves launches, a CPU would run stage 3 on one core)."""
+    chosen = os.environ.get("CLTESS_FUSED_OFFSETS")
+    if chosen not in (None, "", "0", "1"):
+        raise ValueError(f"CLTESS_FUSED_OFFSETS={chosen!r}: expected 0 or 1")
+    if chosen:
+        return chosen == "1"
+    return bool(device.type & cl.device_type.GPU and not device.type & cl.device_type.CPU)
+
+
 def default_work(device: cl.Device) -> str:
     """The work distribution for a device: ``CLTESS_WORK`` if set, else ``DEFAULT_WORK``."""
     gpu = device.type & cl.device_type.GPU and not device.type & cl.device_type.CPU  # Oclgrind says "all"
@@ -137,6 +155,7 @@ class Tessellator:
         self.queue = cl.CommandQueue(self.context, properties=cl.command_queue_properties.PROFILING_ENABLE)
         self.programs = Programs.of(self.context)
         self._prepared = None  # work="*-prep": the prepared patches' scratch buffer (_prepared_points)
+        self.fused_offsets = default_fused_offsets(self.device)  # stage 3 by stages/offsets.cl
         self._kind_patch_sizes: dict = {}
 
     @property
@@ -197,6 +216,8 @@ class Tessellator:
             if kind.count(scene):
                 pattern = request.pattern_for(kind)
                 self.programs.compose(kind, pattern, tolerance, self.work)
+                if self.fused_offsets:
+                    self.programs.kernel("offsets", pattern=pattern)
                 if pattern.fixed_point:  # SD-2's level functions
                     build_level_function_programs(self)
                 if pattern.primitive == "strips":
@@ -510,6 +531,10 @@ class Tessellator:
                 scratch[name] = cl_array.zeros(self.queue, count + 1, np.uint64)
         vertex_counts, index_counts = scratch["vertex_counts"], scratch["index_counts"]
         vertex_offsets, index_offsets = scratch["vertex_offsets"], scratch["index_offsets"]
+        if self.fused_offsets and count <= FUSED_OFFSETS_MAX_PATCHES:  # one launch per range, in order
+            events = [self._fused_offsets(_pattern(k), factors, base, n, vertex_counts, index_counts,
+                                          vertex_offsets, index_offsets) for k, base, n in sorted(ranges, key=lambda r: r[1]) if n]
+            return vertex_offsets, index_offsets, events
         events = [self.programs.kernel("counts", pattern=_pattern(k))(
             self.queue, _global_size(n), None, factors.data, np.uint32(n), np.uint32(base),
             vertex_counts.data, index_counts.data) for k, base, n in ranges if n]
@@ -520,6 +545,18 @@ class Tessellator:
             events += [self.programs.offsets_scan(vertex_counts, vertex_offsets),
                        self.programs.offsets_scan(index_counts, index_offsets)]
         return vertex_offsets, index_offsets, events
+
+    def _fused_offsets(self, pattern, factors, base, n, vertex_counts, index_counts, vertex_offsets,
+                       index_offsets) -> cl.Event:
+        """Stage 3 for patches base .. base+n-1 of one pattern in one work-group
+        (stages/offsets.cl), from offsets[base] on."""
+        kernel = self.programs.kernel("offsets", pattern=pattern)
+        limit = min(FUSED_OFFSETS_GROUP, self.device.max_work_group_size,
+                    kernel.get_work_group_info(cl.kernel_work_group_info.WORK_GROUP_SIZE, self.device))
+        group = 1 << (int(limit).bit_length() - 1)  # a power of two: the scan's steps
+        return kernel(self.queue, (group,), (group,), factors.data, np.uint32(n), np.uint32(base),
+                      vertex_counts.data, index_counts.data, vertex_offsets.data, index_offsets.data,
+                      cl.LocalMemory(8 * group), cl.LocalMemory(8 * group))
 
     def _vertex_arrays(self, n: int) -> dict:
         """The vertex record's arrays (VERTEX_RECORD, in the kernel's argument order)."""
