@@ -23,14 +23,21 @@ __kernel void kind_patch_size(__global uint *size)
 
 __kernel void prepare_patches(__global const float4 *controls, __global const ulong *vertex_offsets,
                               uint first_patch, uint num_patches, uint patch_base,
-                              __global kind_patch *prepared)
+                              __global float4 *prepared)  /* kind_patch records, written word by word */
 {
     uint slot = (uint)get_global_id(0), p = first_patch + slot;
     if (slot >= num_patches || vertex_offsets[p + 1] == vertex_offsets[p])
         return;  /* past the batch, or no vertex (culled, folded): never read */
-    kind_patch patch;
-    kind_load(controls, p - patch_base, &patch);
-    prepared[slot] = patch;
+    union {
+        kind_patch patch;
+        float4 words[(sizeof(kind_patch) + 15) / 16];
+    } made;
+    for (uint k = 0; k < (uint)(sizeof(made.words) / 16); ++k)  /* the float3s' unused lanes: 0 */
+        made.words[k] = (float4)(0.0f);
+    kind_load(controls, p - patch_base, &made.patch);
+    __global float4 *to = prepared + (size_t)slot * (sizeof(kind_patch) / 16);
+    for (uint k = 0; k < (uint)(sizeof(kind_patch) / 16); ++k)  /* word by word (sizeof: a multiple of 16) */
+        to[k] = made.words[k];
 }
 
 /* The patch owning vertex `at`, given that it lies past patch p's vertices: mostly the next

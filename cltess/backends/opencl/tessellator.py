@@ -218,6 +218,8 @@ class Tessellator:
                 self.programs.compose(kind, pattern, tolerance, self.work)
                 if self.fused_offsets:
                     self.programs.kernel("offsets", pattern=pattern)
+                if self.work.endswith("-prep"):  # before the plan's buffers (prepared_scratch)
+                    self.prepared_scratch(kind, pattern, kind.count(scene))
                 if pattern.fixed_point:  # SD-2's level functions
                     build_level_function_programs(self)
                 if pattern.primitive == "strips":
@@ -602,6 +604,23 @@ class Tessellator:
                 self.queue, _global_size(last - first), None, *arguments, *(a.data for a in out.values()))
         return out, list(event) if isinstance(event, tuple) else [event]
 
+    def prepared_scratch(self, kind, pattern, patches: int) -> cl.Buffer:
+        """The scratch buffer of work="*-prep" with room for ``patches`` of ``kind``'s
+        kind_patch (its size as the device compiler lays it out: kernel kind_patch_size), grown
+        when needed.  Tessellator.compose makes it for the scene before the plan's buffers:
+        Oclgrind's uninitialised-value plugin took a buffer made after them for never written
+        (every prepared_points read reported; made first, the same run is clean)."""
+        size = self._kind_patch_sizes.get((kind.name, pattern.header))
+        if size is None:
+            answer = cl_array.empty(self.queue, 1, np.uint32)
+            self.programs.kernel("prepared_points", "kind_patch_size", kind=kind, pattern=pattern)(
+                self.queue, (1,), None, answer.data)
+            size = self._kind_patch_sizes[kind.name, pattern.header] = int(answer.get()[0])
+        needed = max(1, patches) * size
+        if self._prepared is None or self._prepared.size < needed:
+            self._prepared = cl.Buffer(self.context, cl.mem_flags.READ_WRITE, needed + needed // 4)
+        return self._prepared
+
     def _prepared_points(self, controls, factors, vertex_offsets, patch_objects, vertex_range, first, last,
                          forward_differencing, kind, patch_base, pattern, out) -> cl.Event:
         """Stage 4 by vertex from prepared patches (stages/prepared_points.cl): prepare_patches
@@ -610,14 +629,7 @@ class Tessellator:
         prepared_points writes the vertices.  Returns the last event (the profiling span of
         stage 4 runs from the first enqueued to the last)."""
         program = dict(kind=kind, pattern=pattern)
-        size = self._kind_patch_sizes.get((kind.name, pattern.header))
-        if size is None:  # sizeof(kind_patch) as the device compiler lays it out
-            answer = cl_array.empty(self.queue, 1, np.uint32)
-            self.programs.kernel("prepared_points", "kind_patch_size", **program)(self.queue, (1,), None, answer.data)
-            size = self._kind_patch_sizes[kind.name, pattern.header] = int(answer.get()[0])
-        needed = max(1, last - first) * size
-        if self._prepared is None or self._prepared.size < needed:
-            self._prepared = cl.Buffer(self.context, cl.mem_flags.READ_WRITE, needed + needed // 4)
+        self.prepared_scratch(kind, pattern, last - first)
         prepare = self.programs.kernel("prepared_points", "prepare_patches", **program)(
             self.queue, _global_size(last - first), None, controls.data, vertex_offsets.data, np.uint32(first),
             np.uint32(last - first), np.uint32(patch_base), self._prepared)
