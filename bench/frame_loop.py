@@ -19,7 +19,8 @@ On one OpenCL device, in this order, every figure a median (or the best, where s
    its own camera), a ``Session`` per distribution; median device ms of stages 1-5, of stage 3
    (counts and scans), 4 and 5 over ``--repeat`` frames; bytes written; GB/s and the fraction
    of the fill bandwidth; and whether every distribution wrote the same bits (a hash of the
-   fetched output).  Then stage 3 with one scan of (vertex, index) pairs against two scans.
+   fetched output).  Then stage 3 in one launch (stages/offsets.cl), with one scan of (vertex,
+   index) pairs, and with two scans.
    ``--variants-only`` runs sections 1, 2b and nothing else.
 3. **Frame loop on the paper's scenes** (``cltess bench``'s suite, 0.5 px): a ``Session``
    follows ``--frames`` cameras on a circle around each scene's camera target.  Per frame:
@@ -56,7 +57,7 @@ import pyopencl as cl  # noqa: E402
 
 import cltess  # noqa: E402
 from cltess.backends.opencl import Tessellator  # noqa: E402
-from cltess.backends.opencl.tessellator import WORK_DISTRIBUTIONS  # noqa: E402
+from cltess.backends.opencl.tessellator import FUSED_OFFSETS_MAX_PATCHES, WORK_DISTRIBUTIONS  # noqa: E402
 from cltess.bench.suite import SUITE, device_info, machine_info, resolve_scenes  # noqa: E402
 from cltess.bench.scenes import PIXELS, mesh_camera  # noqa: E402
 from cltess.io import load_scene  # noqa: E402
@@ -279,20 +280,20 @@ def work_variants(tessellator, scenes, repeat: int, band: dict, works=VARIANTS) 
 def scan_variants(tessellator, scenes, repeat: int) -> list[dict]:
     """Stage 3 (counts and offsets) with one scan of (vertex, index) pairs against two scans
     (``Tessellator.one_scan``), median device ms over session frames, per scene."""
-    out, saved = [], tessellator.one_scan
+    out, saved = [], (tessellator.one_scan, tessellator.fused_offsets)
     try:
         for name, scene, request in scenes:
             row = {"scene": name, "patches": scene.num_patches}
-            for one in (True, False):
-                tessellator.one_scan = one
+            for key, one, fused in (("fused_ms", True, True), ("one_scan_ms", True, False), ("two_scans_ms", False, False)):
+                tessellator.one_scan, tessellator.fused_offsets = one, fused
                 session = cltess.Session(scene, tessellator=tessellator, **request)
                 session.tessellate()
                 runs = [session.tessellate() for _ in range(repeat)]
-                row["one_scan_ms" if one else "two_scans_ms"] = statistics.median(r.stage_ms["counts"] for r in runs)
+                row[key] = statistics.median(r.stage_ms["counts"] for r in runs)
                 del runs, session
             out.append(row)
     finally:
-        tessellator.one_scan = saved
+        tessellator.one_scan, tessellator.fused_offsets = saved
     return out
 
 
@@ -400,9 +401,10 @@ def report(record: dict) -> str:
              f"| {gb(band['fill_bytes_per_s'])} | {gb(band['pinned_read_bytes_per_s'])} | "
              f"{gb(band['pageable_read_bytes_per_s'])} | {band['bytes'] >> 20} |", ""]
     lines += variants_report(record["variants"], band) + [""]
-    lines += ["Stage 3 (counts kernel and offsets scan), device ms, default work distribution:", "",
-              "| scene | patches | one scan of (vertex, index) pairs | two scans |", "|---|---|---|---|"]
-    lines += [f"| {r['scene']} | {r['patches']:,} | {r['one_scan_ms']:.3f} | {r['two_scans_ms']:.3f} |"
+    lines += ["Stage 3 (counts and offsets), device ms, default work distribution; fused: stages/offsets.cl, one "
+              f"launch per range (above {FUSED_OFFSETS_MAX_PATCHES:,} patches: the one scan):", "",
+              "| scene | patches | fused | one scan of (vertex, index) pairs | two scans |", "|---|---|---|---|---|"]
+    lines += [f"| {r['scene']} | {r['patches']:,} | {r['fused_ms']:.3f} | {r['one_scan_ms']:.3f} | {r['two_scans_ms']:.3f} |"
               for r in record["scans"]] + [""]
     if "uniform" not in record:  # --variants-only
         return "\n".join(lines)
