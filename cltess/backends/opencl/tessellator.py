@@ -64,7 +64,11 @@ WORK_DISTRIBUTIONS = ("patch", "rows", "vertex", "point", "vertex-prep", "point-
 #: The default per device type, chosen by bench/frame_loop.py (bench/RESULTS.md, "Issue 15:
 #: kernels"): CPUs keep a patch per work-item (the point kernels replay forward differencing
 #: per vertex: more arithmetic, which a CPU pays); GPUs a work-item per vertex and triangle.
-DEFAULT_WORK = {"gpu": "point", "other": "patch"}
+#: GPUs "point-prep" (issue 15, gpu15): the point kernels with the patches prepared once per frame,
+#: chosen by reasoning (less work per vertex than "point", measured 18-21% less stage 4 time on
+#: Intel's CPU runtime on uniform level 16), not yet measured on a GPU: bench/frame_loop.py
+#: --work gpu prints the comparison.
+DEFAULT_WORK = {"gpu": "point-prep", "other": "patch"}
 
 
 #: Stage 3 in one launch per range of patches (stages/offsets.cl: counts and the scan by one
