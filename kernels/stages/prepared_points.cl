@@ -5,7 +5,9 @@
  * centred_patch with 48 divisions.  Here that is done once per patch and frame:
  *
  *   prepare_patches   a work-item per patch of the batch: kind_load, and the kind_patch stored
- *                     as it is to prepared[p - first_patch] (a patch without vertices is skipped);
+ *                     to prepared[p - first_patch], float4 by float4 with its unused lanes (a
+ *                     float3's fourth) zeroed, so no undefined byte is stored (Oclgrind's
+ *                     uninitialised-value pass); a patch without vertices is skipped;
  *   prepared_points   as vertex_points, the patch copied from prepared[] (no arithmetic; the
  *                     lanes of a warp mostly read the same patch: cached) instead of kind_load;
  *   kind_patch_size   sizeof(kind_patch), for the host's scratch buffer.
