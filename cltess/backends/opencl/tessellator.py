@@ -96,6 +96,8 @@ def default_work(device: cl.Device) -> str:
     if chosen not in WORK_DISTRIBUTIONS:
         raise ValueError(f"CLTESS_WORK={chosen!r}: expected one of {', '.join(WORK_DISTRIBUTIONS)}")
     return chosen
+
+
 VERIFY_ORDER = 6  # Tessellator.verify: 28 points per triangle, corners and edges included
 VERIFY_MAX_TRIANGLES = 4_000_000  # above this, every k-th triangle is verified
 
@@ -146,8 +148,8 @@ class Tessellator:
 
     def __init__(self, device: cl.Device | str | None = None, rows_in_parallel: bool = False,
                  work: str | None = None):
-        """work: how stages 4-5 spread over work-items (``WORK_DISTRIBUTIONS``: "patch", "rows"
-        or "point", bitwise the same output); default per device type (``default_work``).
+        """work: how stages 4-5 spread over work-items (``WORK_DISTRIBUTIONS``: "patch", "rows",
+        "vertex" or "point", bitwise the same output); default per device type (``default_work``).
         rows_in_parallel=True is work="rows" (stages/vertex_rows.cl)."""
         self.device = device if isinstance(device, cl.Device) else pick_device(device)
         self.one_scan = os.environ.get("CLTESS_ONE_SCAN", "1") != "0"  # stage 3: one scan, else two
