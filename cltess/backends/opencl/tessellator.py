@@ -149,7 +149,8 @@ class Tessellator:
     def __init__(self, device: cl.Device | str | None = None, rows_in_parallel: bool = False,
                  work: str | None = None):
         """work: how stages 4-5 spread over work-items (``WORK_DISTRIBUTIONS``: "patch", "rows",
-        "vertex" or "point", bitwise the same output); default per device type (``default_work``).
+        "vertex", "point", "vertex-prep" or "point-prep", bitwise the same output); default per
+        device type (``default_work``).
         rows_in_parallel=True is work="rows" (stages/vertex_rows.cl)."""
         self.device = device if isinstance(device, cl.Device) else pick_device(device)
         self.one_scan = os.environ.get("CLTESS_ONE_SCAN", "1") != "0"  # stage 3: one scan, else two
