@@ -284,7 +284,8 @@ def scan_variants(tessellator, scenes, repeat: int) -> list[dict]:
     try:
         for name, scene, request in scenes:
             row = {"scene": name, "patches": scene.num_patches}
-            for key, one, fused in (("fused_ms", True, True), ("one_scan_ms", True, False), ("two_scans_ms", False, False)):
+            for key, one, fused in (("fused_ms", True, True), ("one_scan_ms", True, False),
+                                    ("two_scans_ms", False, False)):
                 tessellator.one_scan, tessellator.fused_offsets = one, fused
                 session = cltess.Session(scene, tessellator=tessellator, **request)
                 session.tessellate()
@@ -404,8 +405,8 @@ def report(record: dict) -> str:
     lines += ["Stage 3 (counts and offsets), device ms, default work distribution; fused: stages/offsets.cl, one "
               f"launch per range (above {FUSED_OFFSETS_MAX_PATCHES:,} patches: the one scan):", "",
               "| scene | patches | fused | one scan of (vertex, index) pairs | two scans |", "|---|---|---|---|---|"]
-    lines += [f"| {r['scene']} | {r['patches']:,} | {r['fused_ms']:.3f} | {r['one_scan_ms']:.3f} | {r['two_scans_ms']:.3f} |"
-              for r in record["scans"]] + [""]
+    lines += [f"| {r['scene']} | {r['patches']:,} | {r['fused_ms']:.3f} | {r['one_scan_ms']:.3f} | "
+              f"{r['two_scans_ms']:.3f} |" for r in record["scans"]] + [""]
     if "uniform" not in record:  # --variants-only
         return "\n".join(lines)
     level = record["uniform"]

@@ -535,7 +535,8 @@ def run_scenario(name: str, tessellator, out_dir: Path) -> dict:
         base, cap = POINTS[name] if isinstance(POINTS[name], tuple) else (POINTS[name], None)
         scene, options = SCENARIOS[base]()
         saved = tessellator.work
-        tessellator.work = "point-prep" if name in PREPARED_POINTS else "point"  # before the plan: its programs are built before any buffer
+        # before the plan: its programs (and the prep scratch buffer) are made before any buffer
+        tessellator.work = "point-prep" if name in PREPARED_POINTS else "point"
         try:
             if cap is None:
                 plan = tessellator.plan(scene, **options)

@@ -542,7 +542,8 @@ class Tessellator:
         vertex_offsets, index_offsets = scratch["vertex_offsets"], scratch["index_offsets"]
         if self.fused_offsets and count <= FUSED_OFFSETS_MAX_PATCHES:  # one launch per range, in order
             events = [self._fused_offsets(_pattern(k), factors, base, n, vertex_counts, index_counts,
-                                          vertex_offsets, index_offsets) for k, base, n in sorted(ranges, key=lambda r: r[1]) if n]
+                                          vertex_offsets, index_offsets)
+                      for k, base, n in sorted(ranges, key=lambda r: r[1]) if n]
             return vertex_offsets, index_offsets, events
         events = [self.programs.kernel("counts", pattern=_pattern(k))(
             self.queue, _global_size(n), None, factors.data, np.uint32(n), np.uint32(base),
