@@ -19,7 +19,8 @@ On one OpenCL device, in this order, every figure a median (or the best, where s
    its own camera), a ``Session`` per distribution; median device ms of stages 1-5, of stage 3
    (counts and scans), 4 and 5 over ``--repeat`` frames; bytes written; GB/s and the fraction
    of the fill bandwidth; and whether every distribution wrote the same bits (a hash of the
-   fetched output).  Then stage 3 with one scan of (vertex, index) pairs against two scans.
+   fetched output).  Then stage 3 in one launch (stages/offsets.cl), with one scan of (vertex,
+   index) pairs, and with two scans.
    ``--variants-only`` runs sections 1, 2b and nothing else.
 3. **Frame loop on the paper's scenes** (``cltess bench``'s suite, 0.5 px): a ``Session``
    follows ``--frames`` cameras on a circle around each scene's camera target.  Per frame:
@@ -56,7 +57,7 @@ import pyopencl as cl  # noqa: E402
 
 import cltess  # noqa: E402
 from cltess.backends.opencl import Tessellator  # noqa: E402
-from cltess.backends.opencl.tessellator import WORK_DISTRIBUTIONS  # noqa: E402
+from cltess.backends.opencl.tessellator import FUSED_OFFSETS_MAX_PATCHES, WORK_DISTRIBUTIONS  # noqa: E402
 from cltess.bench.suite import SUITE, device_info, machine_info, resolve_scenes  # noqa: E402
 from cltess.bench.scenes import PIXELS, mesh_camera  # noqa: E402
 from cltess.io import load_scene  # noqa: E402
@@ -237,8 +238,14 @@ def output_digest(tess) -> str:
 
 
 #: The side-by-side table's variants: a work distribution, "/N": N records per work-item of the
-#: record kernels (Tessellator.records_per_item; without: RECORDS_PER_ITEM).
-VARIANTS = ["patch", "rows", "vertex", "point", "point/1", "point/16"]
+#: record kernels (Tessellator.records_per_item; without: RECORDS_PER_ITEM), ":direct": stage 4
+#: by direct evaluation (forward_differencing=False; bitwise other bits than with it, so its
+#: "same bits" is among the ":direct" variants of the scene).
+VARIANTS = ["patch", "rows", "vertex", "point", "point/1", "point/16", "vertex-prep", "point-prep"]
+#: The GPU comparison of issue 15 (stage 4 from prepared patches), forward differencing on and off.
+GPU_VARIANTS = ["patch", "vertex", "point", "point/16", "vertex-prep", "point-prep", "point-prep/16",
+                "patch:direct", "vertex:direct", "point/16:direct", "vertex-prep:direct", "point-prep:direct",
+                "point-prep/16:direct"]
 
 
 def work_variants(tessellator, scenes, repeat: int, band: dict, works=VARIANTS) -> list[dict]:
@@ -248,9 +255,11 @@ def work_variants(tessellator, scenes, repeat: int, band: dict, works=VARIANTS) 
         for name, scene, request in scenes:
             for work in works:
                 say(f"work distributions: {name}, {work}")
-                tessellator.work, _, per_item = work.partition("/")
+                spec, _, evaluation = work.partition(":")
+                tessellator.work, _, per_item = spec.partition("/")
                 tessellator.records_per_item = int(per_item) if per_item else None
-                session = cltess.Session(scene, tessellator=tessellator, **request)
+                options = dict(request, forward_differencing=False) if evaluation == "direct" else request
+                session = cltess.Session(scene, tessellator=tessellator, **options)
                 first = session.tessellate().fetch()  # builds, uploads; its bits
                 digest, size, triangles = output_digest(first), output_bytes(first), first.num_triangles
                 del first
@@ -271,20 +280,21 @@ def work_variants(tessellator, scenes, repeat: int, band: dict, works=VARIANTS) 
 def scan_variants(tessellator, scenes, repeat: int) -> list[dict]:
     """Stage 3 (counts and offsets) with one scan of (vertex, index) pairs against two scans
     (``Tessellator.one_scan``), median device ms over session frames, per scene."""
-    out, saved = [], tessellator.one_scan
+    out, saved = [], (tessellator.one_scan, tessellator.fused_offsets)
     try:
         for name, scene, request in scenes:
             row = {"scene": name, "patches": scene.num_patches}
-            for one in (True, False):
-                tessellator.one_scan = one
+            for key, one, fused in (("fused_ms", True, True), ("one_scan_ms", True, False),
+                                    ("two_scans_ms", False, False)):
+                tessellator.one_scan, tessellator.fused_offsets = one, fused
                 session = cltess.Session(scene, tessellator=tessellator, **request)
                 session.tessellate()
                 runs = [session.tessellate() for _ in range(repeat)]
-                row["one_scan_ms" if one else "two_scans_ms"] = statistics.median(r.stage_ms["counts"] for r in runs)
+                row[key] = statistics.median(r.stage_ms["counts"] for r in runs)
                 del runs, session
             out.append(row)
     finally:
-        tessellator.one_scan = saved
+        tessellator.one_scan, tessellator.fused_offsets = saved
     return out
 
 
@@ -294,7 +304,8 @@ def variants_report(rows: list[dict], band: dict) -> list[str]:
              "| scene | triangles | MB written | work | stages 1-5 ms | stage 3 ms | stage 4 ms | stage 5 ms | "
              "GB/s | % of fill | same bits |", "|---|---|---|---|---|---|---|---|---|---|---|"]
     for row in rows:
-        peers = {r["digest"] for r in rows if r["scene"] == row["scene"]}
+        direct = row["work"].endswith(":direct")
+        peers = {r["digest"] for r in rows if r["scene"] == row["scene"] and r["work"].endswith(":direct") == direct}
         lines.append(f"| {row['scene']} | {row['triangles']:,} | {row['bytes'] / 1e6:.1f} | {row['work']} | "
                      f"{row['device_ms']:.3f} | {row['counts_ms']:.3f} | {row['vertices_ms']:.3f} | "
                      f"{row['indices_ms']:.3f} | {row['bytes'] / (row['device_ms'] / 1e3) / 1e9:.1f} | "
@@ -391,10 +402,11 @@ def report(record: dict) -> str:
              f"| {gb(band['fill_bytes_per_s'])} | {gb(band['pinned_read_bytes_per_s'])} | "
              f"{gb(band['pageable_read_bytes_per_s'])} | {band['bytes'] >> 20} |", ""]
     lines += variants_report(record["variants"], band) + [""]
-    lines += ["Stage 3 (counts kernel and offsets scan), device ms, default work distribution:", "",
-              "| scene | patches | one scan of (vertex, index) pairs | two scans |", "|---|---|---|---|"]
-    lines += [f"| {r['scene']} | {r['patches']:,} | {r['one_scan_ms']:.3f} | {r['two_scans_ms']:.3f} |"
-              for r in record["scans"]] + [""]
+    lines += ["Stage 3 (counts and offsets), device ms, default work distribution; fused: stages/offsets.cl, one "
+              f"launch per range (above {FUSED_OFFSETS_MAX_PATCHES:,} patches: the one scan):", "",
+              "| scene | patches | fused | one scan of (vertex, index) pairs | two scans |", "|---|---|---|---|---|"]
+    lines += [f"| {r['scene']} | {r['patches']:,} | {r['fused_ms']:.3f} | {r['one_scan_ms']:.3f} | "
+              f"{r['two_scans_ms']:.3f} |" for r in record["scans"]] + [""]
     if "uniform" not in record:  # --variants-only
         return "\n".join(lines)
     level = record["uniform"]
@@ -442,14 +454,18 @@ def main(argv=None) -> int:
     parser.add_argument("--json", help="write the record here too")
     parser.add_argument("--work", nargs="*", default=VARIANTS,
                         help=f"work distributions of the side-by-side table ({', '.join(WORK_DISTRIBUTIONS)}; "
-                             f"'point/N': N records per work-item; default: {' '.join(VARIANTS)})")
+                             f"'point/N': N records per work-item; ':direct' suffix: no forward differencing; "
+                             f"'gpu': {' '.join(GPU_VARIANTS)}; default: {' '.join(VARIANTS)})")
     parser.add_argument("--variants-only", action="store_true",
                         help="bandwidth and the work distributions side by side only (no frame loop, no NumPy grid)")
     args = parser.parse_args(argv)
+    args.work = [w for work in args.work for w in (GPU_VARIANTS if work == "gpu" else [work])]
     for work in args.work:
-        name, _, per_item = work.partition("/")
-        if name not in WORK_DISTRIBUTIONS or (per_item and not per_item.isdigit()):
-            parser.error(f"--work {work}: expected one of {', '.join(WORK_DISTRIBUTIONS)}, optionally /N")
+        spec, _, evaluation = work.partition(":")
+        name, _, per_item = spec.partition("/")
+        if name not in WORK_DISTRIBUTIONS or (per_item and not per_item.isdigit()) or evaluation not in ("", "direct"):
+            parser.error(f"--work {work}: expected one of {', '.join(WORK_DISTRIBUTIONS)}, optionally /N, "
+                         "optionally :direct")
     tessellator = Tessellator(args.device)
     record = {"device": device_info(tessellator.device), "machine": machine_info(), "frames": args.frames,
               "command": " ".join(sys.argv), "date": time.strftime("%Y-%m-%d %H:%M:%S %z"),

@@ -5,6 +5,7 @@
 #   bash bench/gpu_issues.sh OUTDIR speed      # bench/frame_loop.py, bench/semi_uniform.py
 #   bash bench/gpu_issues.sh OUTDIR patterns   # bench/silhouette.py, bench/sd2.py, bench/esc.py
 #   bash bench/gpu_issues.sh OUTDIR kernels    # issue 15's work distributions side by side, bitwise tests
+#   bash bench/gpu_issues.sh OUTDIR gpu15      # the same with prepared patches, :direct, fused stage 3
 #
 # Expects in .whl/ the Python 3.12 manylinux x86_64 wheels of pyopencl and its dependencies,
 # mako, trimesh, tqdm (as bench/gpu_run.sh) and NVIDIA's OpenCL library in
@@ -12,7 +13,7 @@
 # take the others with it; its output and exit code are in OUTDIR.
 set -u
 out=${1:?usage: bash bench/gpu_issues.sh OUTDIR speed|patterns}
-which=${2:?usage: bash bench/gpu_issues.sh OUTDIR speed|patterns|kernels}
+which=${2:?usage: bash bench/gpu_issues.sh OUTDIR speed|patterns|kernels|gpu15}
 . bench/gpu_setup.sh
 { nvidia-smi -L; python3 -m cltess devices; } > "$out/machine-$which.txt" 2>&1
 run() {  # run NAME SECONDS COMMAND...
@@ -32,4 +33,7 @@ case $which in
   kernels)
     run frame_loop_variants 400 python3 bench/frame_loop.py --device nvidia --variants-only --json "$out/frame_loop_variants.json"
     run work_points_tests 150 env CLTESS_DEVICE=nvidia python3 -m pytest -q -p no:cacheprovider tests/test_work_points.py ;;
+  gpu15)  # issue 15 on the GPU: prepared patches, direct evaluation, stage 3 in one launch (branch gpu15)
+    run frame_loop_gpu15 500 python3 bench/frame_loop.py --device nvidia --variants-only --work gpu --scenes tea_table killeroo herd spheres model_zoo --json "$out/frame_loop_gpu15.json"
+    run gpu15_tests 200 env CLTESS_DEVICE=nvidia python3 -m pytest -q -p no:cacheprovider tests/test_work_points.py tests/test_fused_offsets.py tests/test_counts.py ;;
 esac

@@ -406,6 +406,19 @@ POINTS = {"uniform_by_points": "uniform", "many_patches_by_points": "many_patche
           "collapsed_bottom_direct_by_points": "collapsed_bottom_direct", "collapsed_lid_by_points": "collapsed_lid",
           "mixed_culled_by_points": "mixed_culled", "esc_by_points": "esc",
           "many_patches_batched_by_points": ("many_patches", 4096)}  # batches: first_patch > 0
+#: The same with stage 4 from prepared patches (Tessellator(work="point-prep"):
+#: stages/prepared_points.cl prepare_patches and prepared_points; culled patches not prepared,
+#: forward differencing and direct, two kinds, batches); also in POINTS (bitwise checks).
+PREPARED_POINTS = {"uniform_by_prepared_points": "uniform", "pn_icosphere_by_prepared_points": "pn_icosphere",
+                   "collapsed_bottom_direct_by_prepared_points": "collapsed_bottom_direct",
+                   "mixed_culled_by_prepared_points": "mixed_culled", "esc_by_prepared_points": "esc",
+                   "many_patches_batched_by_prepared_points": ("many_patches", 4096)}
+POINTS.update(PREPARED_POINTS)
+#: Scenarios whose stage 3 is one launch per range (Tessellator.fused_offsets: stages/offsets.cl),
+#: with work-groups of FUSED_OFFSETS_GROUP_HERE patches so that a range takes several tiles: two
+#: kinds (two ranges, the second from the first's total), culled patches, more patches than a tile.
+FUSED_OFFSETS = {"mixed_culled_fused_offsets": "mixed_culled", "many_patches_fused_offsets": "many_patches"}
+FUSED_OFFSETS_GROUP_HERE = 16
 #: Scenarios of silhouette refinement (cltess/backends/opencl/silhouette.py): a scene and the
 #: refiner's options, one frame from the eye (x, y, z); every per-frame kernel
 #: (silhouette_alpha, silhouette_levels, crack_free, counts, silhouette_vertices, indices).
@@ -515,11 +528,23 @@ def run_scenario(name: str, tessellator, out_dir: Path) -> dict:
             tess = tessellator.emit(plan, 0, plan.num_patches)
         finally:
             tessellator.rows_in_parallel, opencl.MAX_ROWS_PER_PATCH = saved
+    elif name in FUSED_OFFSETS:
+        from cltess.backends.opencl import tessellator as opencl
+
+        scene, options = SCENARIOS[FUSED_OFFSETS[name]]()
+        saved = tessellator.fused_offsets, opencl.FUSED_OFFSETS_GROUP
+        tessellator.fused_offsets, opencl.FUSED_OFFSETS_GROUP = True, FUSED_OFFSETS_GROUP_HERE
+        try:  # its program built before the plan's buffers (Tessellator.compose)
+            plan = tessellator.plan(scene, **options)
+            tess = tessellator.emit(plan, 0, plan.num_patches)
+        finally:
+            tessellator.fused_offsets, opencl.FUSED_OFFSETS_GROUP = saved
     elif name in POINTS:
         base, cap = POINTS[name] if isinstance(POINTS[name], tuple) else (POINTS[name], None)
         scene, options = SCENARIOS[base]()
         saved = tessellator.work
-        tessellator.work = "point"  # before the plan: its programs are built before any buffer
+        # before the plan: its programs (and the prep scratch buffer) are made before any buffer
+        tessellator.work = "point-prep" if name in PREPARED_POINTS else "point"
         try:
             if cap is None:
                 plan = tessellator.plan(scene, **options)

@@ -31,6 +31,8 @@ def compositions():
                     yield stage, composition(stage, kind=kind, pattern=pattern, tolerance=tolerance)
             yield "vertex_rows", composition("vertex_rows", kind=kind, pattern=pattern)  # issue 15
             yield "vertex_points", composition("vertex_points", kind=kind, pattern=pattern)
+            yield "prepared_points", composition("prepared_points", kind=kind, pattern=pattern)
+            yield "offsets", composition("offsets", pattern=pattern)  # stage 3 in one launch
             yield "triangles", composition("triangles", pattern=pattern)
         semi_uniform = pattern_named("semi_uniform", kind.domain)
         yield "level_vertices", composition("level_vertices", kind=kind, pattern=semi_uniform)  # by level

@@ -36,7 +36,7 @@ from cltess.io.npz import load_npz
 
 HERE = Path(__file__).resolve().parent
 NAMES = [*scenarios.SCENARIOS, *scenarios.BATCHED, *scenarios.BY_LEVEL, *scenarios.ROWS_IN_PARALLEL, *scenarios.POINTS,
-         *scenarios.SILHOUETTE]
+         *scenarios.SILHOUETTE, *scenarios.FUSED_OFFSETS]
 
 PASSES = {
     "checks": dict(env=scenarios.OCLGRIND_ENV, args=[],
@@ -257,6 +257,11 @@ def test_results_match_pocl(oclgrind, tmp_path_factory, tessellator, pass_name):
                 by_points = load_npz(run.out_dir / f"{points}.npz")
                 for field in ("positions", "normals", "uv", "patch_ids", "object_ids", "triangles"):
                     assert np.array_equal(getattr(by_points, field), getattr(got, field)), f"{points}: {field}"
+        for fused, base in scenarios.FUSED_OFFSETS.items():  # stages/offsets.cl: the same output
+            if base == name and fused in run.results:
+                by_fused = load_npz(run.out_dir / f"{fused}.npz")
+                for field in ("positions", "normals", "uv", "patch_ids", "object_ids", "triangles", "factors"):
+                    assert np.array_equal(getattr(by_fused, field), getattr(got, field)), f"{fused}: {field}"
         if name in scenarios.VERIFIED:
             plan = tessellator.plan(scene, **options)
             ours = tessellator.verify(scene, plan, tessellator.emit(plan, 0, plan.num_patches))

@@ -33,6 +33,8 @@ STAGE_AXES = {
     "vertex_rows": ("kind", "pattern"),  # stage 4 a work-item per row (Tessellator(work="rows"))
     "vertex_points": ("kind", "pattern"),  # stage 4 a work-item per vertex (Tessellator(work="point"))
     "triangles": ("pattern",),  # stage 5 a work-item per triangle (Tessellator(work="point"))
+    "offsets": ("pattern",),  # stage 3 in one launch (Tessellator.fused_offsets)
+    "prepared_points": ("kind", "pattern"),  # stage 4 per vertex from prepared patches (work="*-prep")
     "verify": ("kind",),  # on request only (Tessellator.verify), so not in STAGES
     # silhouette refinement per frame (silhouette.py; they include criteria/silhouette.h)
     "silhouette_alpha": (),
@@ -54,7 +56,8 @@ offset_pair offset_pair_add(offset_pair a, offset_pair b) { return offset_pair_o
 
 #: The stage 4-5 programs of a work distribution other than a patch per work-item
 #: (tessellator.py WORK_DISTRIBUTIONS).
-WORK_STAGES = {"rows": ("vertex_rows",), "vertex": ("vertex_points",), "point": ("vertex_points", "triangles")}
+WORK_STAGES = {"rows": ("vertex_rows",), "vertex": ("vertex_points",), "point": ("vertex_points", "triangles"),
+               "vertex-prep": ("prepared_points",), "point-prep": ("prepared_points", "triangles")}
 
 
 def kernel_dir() -> Path:

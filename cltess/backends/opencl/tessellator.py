@@ -57,11 +57,36 @@ RECORDS_PER_ITEM = 4
 #: vertex (stages/vertex_points.cl), stage 5 per patch; "point" a work-item per output vertex and
 #: per output triangle (stages/vertex_points.cl, stages/triangles.cl: consecutive work-items
 #: write consecutive records).  All write the same bits.
-WORK_DISTRIBUTIONS = ("patch", "rows", "vertex", "point")
+#: "vertex-prep" and "point-prep": the same, with each visible patch's kind_patch made once per
+#: frame (stages/prepared_points.cl prepare_patches, into a scratch buffer) and stage 4's
+#: work-items copying it instead of re-running kind_load at every patch change (issue 15, GPUs).
+WORK_DISTRIBUTIONS = ("patch", "rows", "vertex", "point", "vertex-prep", "point-prep")
 #: The default per device type, chosen by bench/frame_loop.py (bench/RESULTS.md, "Issue 15:
 #: kernels"): CPUs keep a patch per work-item (the point kernels replay forward differencing
 #: per vertex: more arithmetic, which a CPU pays); GPUs a work-item per vertex and triangle.
-DEFAULT_WORK = {"gpu": "point", "other": "patch"}
+#: GPUs "point-prep" (issue 15, gpu15): the point kernels with the patches prepared once per frame,
+#: chosen by reasoning (less work per vertex than "point", measured 18-21% less stage 4 time on
+#: Intel's CPU runtime on uniform level 16), not yet measured on a GPU: bench/frame_loop.py
+#: --work gpu prints the comparison.
+DEFAULT_WORK = {"gpu": "point-prep", "other": "patch"}
+
+
+#: Stage 3 in one launch per range of patches (stages/offsets.cl: counts and the scan by one
+#: work-group) up to this many patches; more go through the counts kernel and pyopencl.scan.
+FUSED_OFFSETS_MAX_PATCHES = 1 << 16
+#: The fused launch's work-group size at most (a power of two; less where the device says so).
+FUSED_OFFSETS_GROUP = 1024
+
+
+def default_fused_offsets(device: cl.Device) -> bool:
+    """Stage 3 by stages/offsets.cl: ``CLTESS_FUSED_OFFSETS`` (0 or 1) if set, else on GPUs
+    (one work-group: a GPU saves launches, a CPU would run stage 3 on one core)."""
+    chosen = os.environ.get("CLTESS_FUSED_OFFSETS")
+    if chosen not in (None, "", "0", "1"):
+        raise ValueError(f"CLTESS_FUSED_OFFSETS={chosen!r}: expected 0 or 1")
+    if chosen:
+        return chosen == "1"
+    return bool(device.type & cl.device_type.GPU and not device.type & cl.device_type.CPU)
 
 
 def default_work(device: cl.Device) -> str:
@@ -124,7 +149,8 @@ class Tessellator:
     def __init__(self, device: cl.Device | str | None = None, rows_in_parallel: bool = False,
                  work: str | None = None):
         """work: how stages 4-5 spread over work-items (``WORK_DISTRIBUTIONS``: "patch", "rows",
-        "vertex" or "point", bitwise the same output); default per device type (``default_work``).
+        "vertex", "point", "vertex-prep" or "point-prep", bitwise the same output); default per
+        device type (``default_work``).
         rows_in_parallel=True is work="rows" (stages/vertex_rows.cl)."""
         self.device = device if isinstance(device, cl.Device) else pick_device(device)
         self.one_scan = os.environ.get("CLTESS_ONE_SCAN", "1") != "0"  # stage 3: one scan, else two
@@ -135,6 +161,9 @@ class Tessellator:
         self.context = cl.Context([self.device])
         self.queue = cl.CommandQueue(self.context, properties=cl.command_queue_properties.PROFILING_ENABLE)
         self.programs = Programs.of(self.context)
+        self._prepared = None  # work="*-prep": the prepared patches' scratch buffer (_prepared_points)
+        self.fused_offsets = default_fused_offsets(self.device)  # stage 3 by stages/offsets.cl
+        self._kind_patch_sizes: dict = {}
 
     @property
     def per_item(self) -> int:
@@ -194,6 +223,10 @@ class Tessellator:
             if kind.count(scene):
                 pattern = request.pattern_for(kind)
                 self.programs.compose(kind, pattern, tolerance, self.work)
+                if self.fused_offsets:
+                    self.programs.kernel("offsets", pattern=pattern)
+                if self.work.endswith("-prep"):  # before the plan's buffers (prepared_scratch)
+                    self.prepared_scratch(kind, pattern, kind.count(scene))
                 if pattern.fixed_point:  # SD-2's level functions
                     build_level_function_programs(self)
                 if pattern.primitive == "strips":
@@ -510,6 +543,11 @@ class Tessellator:
                 scratch[name] = cl_array.zeros(self.queue, count + 1, np.uint64)
         vertex_counts, index_counts = scratch["vertex_counts"], scratch["index_counts"]
         vertex_offsets, index_offsets = scratch["vertex_offsets"], scratch["index_offsets"]
+        if self.fused_offsets and count <= FUSED_OFFSETS_MAX_PATCHES:  # one launch per range, in order
+            events = [self._fused_offsets(_pattern(k), factors, base, n, vertex_counts, index_counts,
+                                          vertex_offsets, index_offsets)
+                      for k, base, n in sorted(ranges, key=lambda r: r[1]) if n]
+            return vertex_offsets, index_offsets, events
         events = [self.programs.kernel("counts", pattern=_pattern(k))(
             self.queue, _global_size(n), None, factors.data, np.uint32(n), np.uint32(base),
             vertex_counts.data, index_counts.data) for k, base, n in ranges if n]
@@ -520,6 +558,18 @@ class Tessellator:
             events += [self.programs.offsets_scan(vertex_counts, vertex_offsets),
                        self.programs.offsets_scan(index_counts, index_offsets)]
         return vertex_offsets, index_offsets, events
+
+    def _fused_offsets(self, pattern, factors, base, n, vertex_counts, index_counts, vertex_offsets,
+                       index_offsets) -> cl.Event:
+        """Stage 3 for patches base .. base+n-1 of one pattern in one work-group
+        (stages/offsets.cl), from offsets[base] on."""
+        kernel = self.programs.kernel("offsets", pattern=pattern)
+        limit = min(FUSED_OFFSETS_GROUP, self.device.max_work_group_size,
+                    kernel.get_work_group_info(cl.kernel_work_group_info.WORK_GROUP_SIZE, self.device))
+        group = 1 << (int(limit).bit_length() - 1)  # a power of two: the scan's steps
+        return kernel(self.queue, (group,), (group,), factors.data, np.uint32(n), np.uint32(base),
+                      vertex_counts.data, index_counts.data, vertex_offsets.data, index_offsets.data,
+                      cl.LocalMemory(8 * group), cl.LocalMemory(8 * group))
 
     def _vertex_arrays(self, n: int) -> dict:
         """The vertex record's arrays (VERTEX_RECORD, in the kernel's argument order)."""
@@ -535,7 +585,8 @@ class Tessellator:
         V = stop - start (written into ``out`` when given), and the events.  rows_per_patch:
         work-items per patch of stages/vertex_rows.cl (0: one per patch, stages/vertices.cl;
         None: as ``work``).  work: "patch", "rows" (with ``MAX_ROWS_PER_PATCH``), "vertex" or
-        "point" (stages/vertex_points.cl, a work-item per vertex); None: the Tessellator's ``work``."""
+        "point" (stages/vertex_points.cl, a work-item per vertex), "vertex-prep" or "point-prep"
+        (stages/prepared_points.cl: the patches prepared first); None: the Tessellator's ``work``."""
         out = self._vertex_arrays(vertex_range[1] - vertex_range[0]) if out is None else out
         first, last = patch_range
         if vertex_range[1] == vertex_range[0] or last <= first:
@@ -548,7 +599,10 @@ class Tessellator:
         work = work or self.work
         if rows_per_patch is None and work == "rows":
             rows_per_patch = MAX_ROWS_PER_PATCH
-        if rows_per_patch is None and work in ("vertex", "point"):  # work-items past the part's vertices return
+        if rows_per_patch is None and work in ("vertex-prep", "point-prep"):
+            event = self._prepared_points(controls, factors, vertex_offsets, patch_objects, vertex_range, first, last,
+                                          forward_differencing, kind, patch_base, pattern, out)
+        elif rows_per_patch is None and work in ("vertex", "point"):  # work-items past the part's vertices return
             event = self.programs.kernel("vertex_points", kind=kind, pattern=pattern)(
                 self.queue, _record_groups(vertex_range[1] - vertex_range[0], self.per_item), (WORK_GROUP,),
                 *arguments, np.uint32(self.per_item), *(a.data for a in out.values()))
@@ -559,7 +613,43 @@ class Tessellator:
         else:
             event = self.programs.kernel("vertices", kind=kind, pattern=pattern)(
                 self.queue, _global_size(last - first), None, *arguments, *(a.data for a in out.values()))
-        return out, [event]
+        return out, list(event) if isinstance(event, tuple) else [event]
+
+    def prepared_scratch(self, kind, pattern, patches: int) -> cl.Buffer:
+        """The scratch buffer of work="*-prep" with room for ``patches`` of ``kind``'s
+        kind_patch (its size as the device compiler lays it out: kernel kind_patch_size), grown
+        when needed.  Tessellator.compose makes it for the scene before the plan's buffers:
+        Oclgrind's uninitialised-value plugin took a buffer made after them for never written
+        (every prepared_points read reported; made first, the same run is clean)."""
+        size = self._kind_patch_sizes.get((kind.name, pattern.header))
+        if size is None:
+            answer = cl_array.empty(self.queue, 1, np.uint32)
+            self.programs.kernel("prepared_points", "kind_patch_size", kind=kind, pattern=pattern)(
+                self.queue, (1,), None, answer.data)
+            size = self._kind_patch_sizes[kind.name, pattern.header] = int(answer.get()[0])
+        needed = max(1, patches) * size
+        if self._prepared is None or self._prepared.size < needed:
+            self._prepared = cl.Buffer(self.context, cl.mem_flags.READ_WRITE, needed + needed // 4)
+        return self._prepared
+
+    def _prepared_points(self, controls, factors, vertex_offsets, patch_objects, vertex_range, first, last,
+                         forward_differencing, kind, patch_base, pattern, out) -> cl.Event:
+        """Stage 4 by vertex from prepared patches (stages/prepared_points.cl): prepare_patches
+        writes patches first .. last-1's kind_patch to a scratch buffer (kept, grown as needed;
+        the queue is in order, so a later batch's prepare waits for this batch's reads), then
+        prepared_points writes the vertices.  Returns the last event (the profiling span of
+        stage 4 runs from the first enqueued to the last)."""
+        program = dict(kind=kind, pattern=pattern)
+        self.prepared_scratch(kind, pattern, last - first)
+        prepare = self.programs.kernel("prepared_points", "prepare_patches", **program)(
+            self.queue, _global_size(last - first), None, controls.data, vertex_offsets.data, np.uint32(first),
+            np.uint32(last - first), np.uint32(patch_base), self._prepared)
+        points = self.programs.kernel("prepared_points", **program)(
+            self.queue, _record_groups(vertex_range[1] - vertex_range[0], self.per_item), (WORK_GROUP,),
+            self._prepared, factors.data, vertex_offsets.data, patch_objects.data, np.uint32(first),
+            np.uint32(last - first), np.uint64(vertex_range[0]), np.int32(forward_differencing),
+            np.uint32(self.per_item), *(a.data for a in out.values()))
+        return prepare, points
 
     def stage_indices(self, factors, vertex_offsets, index_offsets, index_range, patch_range,
                       kind=BEZIER, out=None, work: str | None = None):
@@ -575,7 +665,7 @@ class Tessellator:
             return triangles, []
         arguments = (factors.data, vertex_offsets.data, index_offsets.data, np.uint32(first),
                      np.uint32(last - first), np.uint64(index_range[0]))
-        if (work or self.work) == "point":  # work-items past the part's triangles stop
+        if (work or self.work) in ("point", "point-prep"):  # work-items past the part's triangles stop
             event = self.programs.kernel("triangles", pattern=_pattern(kind))(
                 self.queue, _record_groups(n // 3, self.per_item), (WORK_GROUP,), *arguments,
                 np.uint32(self.per_item), triangles.data)

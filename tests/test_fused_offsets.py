@@ -1,0 +1,62 @@
+"""Stage 3 in one launch per range (stages/offsets.cl, Tessellator.fused_offsets, issue 15):
+the same counts and offsets as the counts kernel and pyopencl.scan, and as the NumPy mirror,
+over several tiles of the work-group, two patterns in a row, culled and collapsed patches."""
+import numpy as np
+import pyopencl.array as cl_array
+import pytest
+
+from cltess import reference
+from cltess.backends.opencl import tessellator as opencl
+from support.factors import random_factors, random_triangle_factors
+
+
+@pytest.fixture
+def fused(tessellator):
+    fused = opencl.Tessellator(tessellator.device, work="patch")
+    fused.fused_offsets = True
+    return fused
+
+
+@pytest.mark.parametrize("group", [1, 64, opencl.FUSED_OFFSETS_GROUP])  # 1: no scan step at all
+def test_fused_offsets_are_the_scans(tessellator, fused, rng, monkeypatch, group):
+    from cltess.pipeline import BEZIER, PN
+
+    monkeypatch.setattr(opencl, "FUSED_OFFSETS_GROUP", group)
+    quads, triangles = random_factors(rng, 1000), random_triangle_factors(rng, 700)
+    quads[::7] = 0  # culled
+    quads[3::11, 0] *= -1  # a collapsed edge (stored negated by stage 2)
+    factors = np.concatenate([quads, triangles])
+    ranges = [(BEZIER, 0, 1000), (PN, 1000, 700)]
+    scans = opencl.Tessellator(tessellator.device, work="patch")
+    scans.fused_offsets = False
+    results = []
+    for tess in (scans, fused):
+        scratch = {}
+        for _ in range(2):  # a second call on the same scratch arrays (a session's frames)
+            vertex_offsets, index_offsets, events = tess.stage_counts(
+                cl_array.to_device(tess.queue, factors), kind=ranges, scratch=scratch)
+        results.append((vertex_offsets.get(), index_offsets.get(), scratch["vertex_counts"].get(),
+                        scratch["index_counts"].get(), len(events)))
+    assert results[1][4] == 2  # one launch per range
+    for expected, got in zip(results[0][:4], results[1][:4]):
+        assert np.array_equal(expected, got)
+    counts = reference.counts(quads), reference.counts(triangles, kind="pn")  # the mirror reads the signs
+    for got, field in ((results[1][0], 0), (results[1][1], 1)):
+        assert np.array_equal(got, reference.offsets(np.concatenate([counts[0][field], counts[1][field]])))
+
+
+def test_fused_offsets_above_the_cap_use_the_scans(fused, monkeypatch, rng):
+    monkeypatch.setattr(opencl, "FUSED_OFFSETS_MAX_PATCHES", 10)
+    factors = random_factors(rng, 50)
+    _, _, events = fused.stage_counts(cl_array.to_device(fused.queue, factors))
+    assert len(events) == 2  # the counts kernel and the pair scan
+
+
+def test_fused_offsets_setting(tessellator, monkeypatch):
+    monkeypatch.setenv("CLTESS_FUSED_OFFSETS", "1")
+    assert opencl.Tessellator(tessellator.device).fused_offsets
+    monkeypatch.setenv("CLTESS_FUSED_OFFSETS", "0")
+    assert not opencl.Tessellator(tessellator.device).fused_offsets
+    monkeypatch.setenv("CLTESS_FUSED_OFFSETS", "yes")
+    with pytest.raises(ValueError, match="CLTESS_FUSED_OFFSETS"):
+        opencl.Tessellator(tessellator.device)
