@@ -589,6 +589,7 @@ def main(argv=None) -> int:
 
     pyopencl.characterize.nv_compute_capability = lambda device: None
 
+    from cltess.backends.opencl import tessellator as opencl_tessellator
     from cltess.backends.opencl.programs import Programs
     from cltess.pipeline import Tessellator
 
@@ -599,6 +600,7 @@ def main(argv=None) -> int:
     for name in args.names:
         if args.fresh_context:
             getattr(Programs, "_by_context", {}).pop(tessellator.context, None)  # free the old one
+            opencl_tessellator._CONTEXTS.clear()  # and make a new context
             tessellator = Tessellator()
         print(f"{MARKER} {name}", file=sys.stderr, flush=True)
         if name in SELFTESTS:

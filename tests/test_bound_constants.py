@@ -70,16 +70,21 @@ def test_culled_patches_are_left_for_later(rng):
     assert np.array_equal(wide.factors, fresh.factors) and np.array_equal(wide.triangles, fresh.triangles)
 
 
-def test_constants_are_kept_per_scene_and_context(rng):
+def test_constants_are_kept_per_scene_and_context(rng, monkeypatch):
+    from cltess.backends.opencl import tessellator as opencl_tessellator
+
     patches = random_patches(rng, 40)
     scene = Scene(patches, np.zeros(40, np.int32), name="random")
-    first, second = Tessellator(), Tessellator()  # two contexts
+    first, same_device = Tessellator(), Tessellator()  # one context per device (shared_context)
+    monkeypatch.setattr(opencl_tessellator, "_CONTEXTS", {})
+    second = Tessellator()  # a context of its own
     a = first.tessellate(scene, eps=0.05)
     kept = first.patch_constants(BEZIER, 40, scene)
     assert kept is first.patch_constants(BEZIER, 40, scene)
     assert (kept.get()[:, 0] >= 0).all()
     b = first.tessellate(scene, eps=0.05)
     assert np.array_equal(a.factors, b.factors) and np.array_equal(a.triangles, b.triangles)
+    assert same_device.patch_constants(BEZIER, 40, scene) is kept
     assert second.patch_constants(BEZIER, 40, scene) is not kept  # its own context
     # another tolerance with the kept constants: as on a fresh scene
     kept_run = first.tessellate(scene, eps=0.01)

@@ -61,21 +61,34 @@ RECORDS_PER_ITEM = 4
 #: frame (stages/prepared_points.cl prepare_patches, into a scratch buffer) and stage 4's
 #: work-items copying it instead of re-running kind_load at every patch change (issue 15, GPUs).
 WORK_DISTRIBUTIONS = ("patch", "rows", "vertex", "point", "vertex-prep", "point-prep")
-#: The default per device type, chosen by bench/frame_loop.py (bench/RESULTS.md, "Issue 15:
-#: kernels"): CPUs keep a patch per work-item (the point kernels replay forward differencing
-#: per vertex: more arithmetic, which a CPU pays); GPUs a work-item per vertex and triangle.
-#: GPUs "point-prep" (issue 15, gpu15): the point kernels with the patches prepared once per frame,
-#: chosen by reasoning (less work per vertex than "point", measured 18-21% less stage 4 time on
-#: Intel's CPU runtime on uniform level 16), not yet measured on a GPU: bench/frame_loop.py
-#: --work gpu prints the comparison.
-DEFAULT_WORK = {"gpu": "point-prep", "other": "patch"}
+#: The default per device type, chosen by bench/frame_loop.py --work gpu (bench/RESULTS.md, "Issue
+#: 15: the work distributions on the H100"): CPUs keep a patch per work-item (the point kernels
+#: replay forward differencing per vertex: more arithmetic, which a CPU pays); GPUs a work-item
+#: per vertex and triangle ("point": fastest or within 20% of the fastest on the paper's scenes
+#: on the H100; "point-prep" wins only where patches have hundreds of vertices, uniform level 16).
+DEFAULT_WORK = {"gpu": "point", "other": "patch"}
 
 
 #: Stage 3 in one launch per range of patches (stages/offsets.cl: counts and the scan by one
-#: work-group) up to this many patches; more go through the counts kernel and pyopencl.scan.
-FUSED_OFFSETS_MAX_PATCHES = 1 << 16
+#: work-group) up to this many patches; more go through the counts kernel and pyopencl.scan.  On
+#: the H100 one launch took 0.03 ms against the scans' 0.14-0.25 ms up to 1,536 patches, 0.17
+#: against 0.14 at 11,532 and 0.71 against 0.19 at 32,000 (bench/RESULTS.md, issue 15 on the H100).
+FUSED_OFFSETS_MAX_PATCHES = 1 << 13
 #: The fused launch's work-group size at most (a power of two; less where the device says so).
 FUSED_OFFSETS_GROUP = 1024
+
+
+#: One context per device for the process: the tessellators of a device share it, and with it
+#: its built programs and the scene data kept per context.  A context per tessellator was never
+#: freed (the programs cache holds it) and NVIDIA's driver refuses new contexts after a few
+#: dozen (OUT_OF_HOST_MEMORY).
+_CONTEXTS: dict = {}
+
+
+def shared_context(device: cl.Device) -> cl.Context:
+    if device not in _CONTEXTS:
+        _CONTEXTS[device] = cl.Context([device])
+    return _CONTEXTS[device]
 
 
 def default_fused_offsets(device: cl.Device) -> bool:
@@ -158,7 +171,7 @@ class Tessellator:
         self.work = "rows" if rows_in_parallel else work or default_work(self.device)
         if self.work not in WORK_DISTRIBUTIONS:
             raise ValueError(f"work={self.work!r}: expected one of {', '.join(WORK_DISTRIBUTIONS)}")
-        self.context = cl.Context([self.device])
+        self.context = shared_context(self.device)
         self.queue = cl.CommandQueue(self.context, properties=cl.command_queue_properties.PROFILING_ENABLE)
         self.programs = Programs.of(self.context)
         self._prepared = None  # work="*-prep": the prepared patches' scratch buffer (_prepared_points)
