@@ -52,6 +52,19 @@ def test_fused_offsets_above_the_cap_use_the_scans(fused, monkeypatch, rng):
     assert len(events) == 2  # the counts kernel and the pair scan
 
 
+def test_a_pattern_that_counts_by_walking_uses_the_scans(fused, rng):
+    """ESC's counts walk its bands (Pattern.counts_walk): one work-group would run that walk for
+    every patch on one compute unit, so stage 3 keeps the counts kernel and the scan; a pattern
+    with closed-form counts in the same call takes the one launch."""
+    from cltess.patterns import PATTERNS
+
+    factors = cl_array.to_device(fused.queue, random_factors(rng, 50))
+    assert PATTERNS["esc"].counts_walk and not PATTERNS["quad_transition"].counts_walk
+    _, _, walked = fused.stage_counts(factors, kind=PATTERNS["esc"])
+    _, _, closed = fused.stage_counts(factors, kind=PATTERNS["quad_transition"])
+    assert len(walked) == 2 and len(closed) == 1  # counts kernel + pair scan; one launch
+
+
 def test_fused_offsets_setting(tessellator, monkeypatch):
     monkeypatch.setenv("CLTESS_FUSED_OFFSETS", "1")
     assert opencl.Tessellator(tessellator.device).fused_offsets

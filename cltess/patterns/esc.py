@@ -352,10 +352,10 @@ def _stage1_one_level(patches, tolerance, max_level, max_factor):
 
 
 ESC = Pattern("esc", "quad", 4, "patterns/esc.h", layout, crack="crack/or_masks.h", primitive="strips",
-              stage1=((("PATTERN_ESC", 1),), _stage1), strips=strip_indices)
+              stage1=((("PATTERN_ESC", 1),), _stage1), strips=strip_indices, counts_walk=True)
 
 #: ESC with one level per run (every patch at L = max level, as before per-patch levels): not in
 #: the registry; bench/esc.py adds it to PATTERNS to measure what per-patch levels change.
 ESC_ONE_LEVEL = Pattern("esc_one_level", "quad", 4, "patterns/esc.h", layout, crack="crack/or_masks.h",
                         primitive="strips", stage1=((("PATTERN_ESC", 1), ("ESC_ONE_LEVEL", 1)), _stage1_one_level),
-                        strips=strip_indices)
+                        strips=strip_indices, counts_walk=True)

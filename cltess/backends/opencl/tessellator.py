@@ -556,7 +556,9 @@ class Tessellator:
                 scratch[name] = cl_array.zeros(self.queue, count + 1, np.uint64)
         vertex_counts, index_counts = scratch["vertex_counts"], scratch["index_counts"]
         vertex_offsets, index_offsets = scratch["vertex_offsets"], scratch["index_offsets"]
-        if self.fused_offsets and count <= FUSED_OFFSETS_MAX_PATCHES:  # one launch per range, in order
+        fused = self.fused_offsets and count <= FUSED_OFFSETS_MAX_PATCHES and not any(
+            _pattern(k).counts_walk for k, _, n in ranges if n)  # a walk per patch wants the whole device
+        if fused:  # one launch per range, in order
             events = [self._fused_offsets(_pattern(k), factors, base, n, vertex_counts, index_counts,
                                           vertex_offsets, index_offsets)
                       for k, base, n in sorted(ranges, key=lambda r: r[1]) if n]
