@@ -42,18 +42,7 @@ __kernel void prepare_patches(__global const float4 *controls, __global const ul
         to[k] = made.words[k];
 }
 
-/* The patch owning vertex `at`, given that it lies past patch p's vertices: mostly the next
- * patch, checked first (two loads); else patch_of's binary search from p on. */
-inline uint next_patch_of(__global const ulong *offsets, uint p, uint last, ulong at)
-{
-    if (p + 2 <= last && at < offsets[p + 2] && at >= offsets[p + 1])
-        return p + 1;
-    return patch_of(offsets, p, last, at);
-}
-
-/* As stages/vertex_points.cl (a work-group of G work-items owns G * per_item consecutive
- * vertices of the batch, step k of work-item l writes vertex k G + l of them), with the patch
- * from prepared[]. */
+/* As stages/vertex_points.cl (put_points, stages/rows.h), with the patch from prepared[]. */
 __kernel void prepared_points(__global const kind_patch *restrict prepared, __global const int4 *factors,
                               __global const ulong *vertex_offsets, __global const int *patch_objects,
                               uint first_patch, uint num_patches, ulong vertex_base,
@@ -61,25 +50,7 @@ __kernel void prepared_points(__global const kind_patch *restrict prepared, __gl
                               __global float *positions, __global float *normals, __global float *uv,
                               __global int *patch_ids, __global int *object_ids)
 {
-    uint last = first_patch + num_patches;
-    ulong end = vertex_offsets[last], group = get_local_size(0);
-    ulong at = vertex_offsets[first_patch] + get_group_id(0) * group * per_item + get_local_id(0);
     vertex_out out = {positions, normals, uv, patch_ids, object_ids};
-    uint p = first_patch;
-    ulong patch_start = 0, patch_end = 0;  /* no patch loaded yet */
-    int4 f = (int4)(0);
-    int collapsed = 0, object = 0;
-    kind_patch patch;
-    for (uint k = 0; k < per_item && at < end; ++k, at += group) {
-        if (at >= patch_end) {
-            p = patch_end ? next_patch_of(vertex_offsets, p, last, at) : patch_of(vertex_offsets, p, last, at);
-            patch_start = vertex_offsets[p];
-            patch_end = vertex_offsets[p + 1];
-            f = patch_factors(factors[p], &collapsed);
-            object = patch_objects[p];
-            patch = prepared[p - first_patch];
-        }
-        put_point(&patch, f, collapsed, (uint)(at - patch_start), forward_differencing, out, at - vertex_base,
-                  p, object);
-    }
+    put_points(0, 0, prepared, factors, vertex_offsets, patch_objects, first_patch, num_patches, vertex_base,
+               forward_differencing, per_item, out);
 }
