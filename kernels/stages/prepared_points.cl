@@ -51,6 +51,6 @@ __kernel void prepared_points(__global const kind_patch *restrict prepared, __gl
                               __global int *patch_ids, __global int *object_ids)
 {
     vertex_out out = {positions, normals, uv, patch_ids, object_ids};
-    put_points(0, 0, prepared, factors, vertex_offsets, patch_objects, first_patch, num_patches, vertex_base,
+    put_points(0, 0, 1, prepared, factors, vertex_offsets, patch_objects, first_patch, num_patches, vertex_base,
                forward_differencing, per_item, out);
 }

@@ -126,9 +126,10 @@ inline uint next_patch_of(__global const ulong *offsets, uint p, uint last, ulon
  * owns G * per_item consecutive vertices of the batch (patches first_patch .. first_patch +
  * num_patches - 1), and in step k its work-item l writes vertex k G + l of them, so each step's
  * stores are side by side.  A work-item finds and loads a patch only when its next vertex is in
- * another one: from prepared[p - first_patch] when prepared is given (no arithmetic), else by
- * kind_load from controls.  Work-items past the batch's last vertex stop. */
-ALWAYS_INLINE void put_points(__global const float4 *controls, uint patch_base,
+ * another one: from prepared[p - first_patch] when from_prepared (a literal, so each kernel
+ * keeps one of the two; no arithmetic), else by kind_load from controls.  Work-items past the
+ * batch's last vertex stop. */
+ALWAYS_INLINE void put_points(__global const float4 *controls, uint patch_base, const int from_prepared,
                               __global const kind_patch *prepared, __global const int4 *factors,
                               __global const ulong *vertex_offsets, __global const int *patch_objects,
                               uint first_patch, uint num_patches, ulong vertex_base,
@@ -149,7 +150,7 @@ ALWAYS_INLINE void put_points(__global const float4 *controls, uint patch_base,
             patch_end = vertex_offsets[p + 1];
             f = patch_factors(factors[p], &collapsed);
             object = patch_objects[p];
-            if (prepared)
+            if (from_prepared)
                 patch = prepared[p - first_patch];
             else
                 kind_load(controls, p - patch_base, &patch);

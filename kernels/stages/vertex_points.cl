@@ -19,6 +19,6 @@ __kernel void vertex_points(__global const float4 *controls, __global const int4
                             __global int *patch_ids, __global int *object_ids)
 {
     vertex_out out = {positions, normals, uv, patch_ids, object_ids};
-    put_points(controls, patch_base, 0, factors, vertex_offsets, patch_objects, first_patch, num_patches,
+    put_points(controls, patch_base, 0, 0, factors, vertex_offsets, patch_objects, first_patch, num_patches,
                vertex_base, forward_differencing, per_item, out);
 }
