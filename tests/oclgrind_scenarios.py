@@ -400,18 +400,17 @@ ROWS_IN_PARALLEL = {"many_patches_by_rows": "many_patches", "pn_icosphere_by_row
 #: Scenarios whose stages 4-5 run a work-item per vertex and per triangle (Tessellator(work=
 #: "point"): stages/vertex_points.cl, stages/triangles.cl): forward differencing replayed per
 #: vertex, the quad grid's triangles by pattern_triangle_at (uniform), the per-patch fall-back
-#: (transitions, collapsed edges, PN, semi-uniform, ESC), culled patches, two kinds.
-POINTS = {"uniform_by_points": "uniform", "many_patches_by_points": "many_patches",
-          "pn_icosphere_by_points": "pn_icosphere", "semi_uniform_by_points": "semi_uniform",
-          "collapsed_bottom_direct_by_points": "collapsed_bottom_direct", "collapsed_lid_by_points": "collapsed_lid",
+#: (transitions, collapsed edges, PN, ESC), culled patches, two kinds, batches (one scenario per
+#: path: the suite's time, issue 15).
+POINTS = {"uniform_by_points": "uniform", "pn_icosphere_by_points": "pn_icosphere",
+          "collapsed_bottom_direct_by_points": "collapsed_bottom_direct",
           "mixed_culled_by_points": "mixed_culled", "esc_by_points": "esc",
           "many_patches_batched_by_points": ("many_patches", 4096)}  # batches: first_patch > 0
 #: The same with stage 4 from prepared patches (Tessellator(work="point-prep"):
 #: stages/prepared_points.cl prepare_patches and prepared_points; culled patches not prepared,
-#: forward differencing and direct, two kinds, batches); also in POINTS (bitwise checks).
+#: two kinds, batches; put_point's direct evaluation is POINTS'); also in POINTS (bitwise checks).
 PREPARED_POINTS = {"uniform_by_prepared_points": "uniform", "pn_icosphere_by_prepared_points": "pn_icosphere",
-                   "collapsed_bottom_direct_by_prepared_points": "collapsed_bottom_direct",
-                   "mixed_culled_by_prepared_points": "mixed_culled", "esc_by_prepared_points": "esc",
+                   "mixed_culled_by_prepared_points": "mixed_culled",
                    "many_patches_batched_by_prepared_points": ("many_patches", 4096)}
 POINTS.update(PREPARED_POINTS)
 #: Scenarios whose stage 3 is one launch per range (Tessellator.fused_offsets: stages/offsets.cl),

@@ -80,13 +80,20 @@ def oclgrind():
         pytest.skip(missing)
 
 
+def pass_names(name: str) -> list[str]:
+    """What a pass runs: every scenario (the uninitialised-value pass leaves out the ones it
+    skips, UNINITIALIZED_SKIPPED, to save their simulation time) and the pass's self-tests."""
+    skipped = scenarios.UNINITIALIZED_SKIPPED if name == "uninitialized" else {}
+    return [*(n for n in NAMES if n not in skipped), *PASSES[name]["selftests"]]
+
+
 def run_pass(name: str, tmp_path_factory, names=None) -> Run:
-    """Run one pass (cached per session) of ``names`` (default: every scenario and the pass's
-    self-tests) in a subprocess."""
+    """Run one pass (cached per session) of ``names`` (default: ``pass_names``) in a
+    subprocess."""
     if names is None and name in _RUNS:
         return _RUNS[name]
     spec = PASSES[name]
-    names = names or [*NAMES, *spec["selftests"]]
+    names = names or pass_names(name)
     out_dir = tmp_path_factory.mktemp(f"oclgrind-{name}")
     env = {k: v for k, v in os.environ.items() if not k.startswith(("OCLGRIND_", "PYOPENCL_BUILD"))}
     env.update(spec["env"], CLTESS_DEVICE="oclgrind", OCLGRIND_MAX_ERRORS="1000000")
@@ -99,7 +106,7 @@ def run_pass(name: str, tmp_path_factory, names=None) -> Run:
         if "name" in record:
             results[record["name"]] = record
     run = Run(process.returncode, results, scenarios.parse_stderr(process.stderr), process.stderr, out_dir)
-    if names == [*NAMES, *spec["selftests"]]:
+    if names == pass_names(name):
         _RUNS[name] = run
     return run
 

@@ -38,7 +38,7 @@ def same(expected, got, normals=True):
             assert np.array_equal(getattr(expected, field), getattr(got, field)), field
 
 
-@pytest.mark.parametrize("records_per_item", [1, 3, opencl.RECORDS_PER_ITEM])
+@pytest.mark.parametrize("records_per_item", [3, opencl.RECORDS_PER_ITEM])
 @pytest.mark.parametrize("name, options", CASES)
 def test_points_are_bitwise_the_per_patch_kernels(tessellator, by_points, monkeypatch, name, options,
                                                   records_per_item):
