@@ -49,16 +49,21 @@ def test_points_are_bitwise_the_per_patch_kernels(tessellator, by_points, monkey
     same(expected, got)
 
 
+def same_in_batches(tess, scene, whole):
+    """The scene in more than two batches of ``tess`` (0.5 px) concatenates to ``whole``."""
+    _, batches = tess.tessellate_in_batches(scene, whole.num_vertices * 8, pixels=0.5)
+    batches = list(batches)
+    assert len(batches) > 2
+    for field in ("positions", "normals", "uv", "patch_ids", "object_ids", "triangles"):
+        assert np.array_equal(getattr(whole, field), np.concatenate([getattr(b, field) for b in batches])), field
+
+
 def test_points_in_batches(tessellator, by_points):
     """Batches start mid-scene (first_patch > 0) and at a kind's boundary (tea table: Bézier and PN)."""
     scene = load_scene(SCENES / "tea_table.json")
     per_patch = opencl.Tessellator(tessellator.device, work="patch")
     whole = per_patch.tessellate(scene, pixels=0.5)
-    _, batches = by_points.tessellate_in_batches(scene, whole.num_vertices * 8, pixels=0.5)
-    batches = list(batches)
-    assert len(batches) > 2
-    for field in ("positions", "normals", "uv", "patch_ids", "object_ids", "triangles"):
-        assert np.array_equal(getattr(whole, field), np.concatenate([getattr(b, field) for b in batches])), field
+    same_in_batches(by_points, scene, whole)
 
 
 def test_work_is_checked(tessellator, monkeypatch):
@@ -115,9 +120,5 @@ def test_prepared_points_in_batches_and_with_a_grown_scratch_buffer(tessellator)
     same(per_patch.tessellate(small, eps=1e-3), by_prepared.tessellate(small, eps=1e-3))
     scene = load_scene(SCENES / "tea_table.json")
     whole = per_patch.tessellate(scene, pixels=0.5)
-    _, batches = by_prepared.tessellate_in_batches(scene, whole.num_vertices * 8, pixels=0.5)
-    batches = list(batches)
-    assert len(batches) > 2
-    for field in ("positions", "normals", "uv", "patch_ids", "object_ids", "triangles"):
-        assert np.array_equal(getattr(whole, field), np.concatenate([getattr(b, field) for b in batches])), field
+    same_in_batches(by_prepared, scene, whole)
     assert by_prepared._prepared.size >= by_prepared._kind_patch_sizes[("bezier", "patterns/quad_transition.h")]
