@@ -113,20 +113,11 @@ ALWAYS_INLINE void put_point(__private const kind_patch *patch, int4 f, int coll
     put_vertex(out, at, position, normal, x.xy, p, object);
 }
 
-/* The patch owning vertex `at`, given that it lies past patch p's vertices: mostly the next
- * patch, checked first (two loads); else patch_of's binary search from p on. */
-inline uint next_patch_of(__global const ulong *offsets, uint p, uint last, ulong at)
-{
-    if (p + 2 <= last && at < offsets[p + 2] && at >= offsets[p + 1])
-        return p + 1;
-    return patch_of(offsets, p, last, at);
-}
-
 /* Stage 4 by vertex (stages/vertex_points.cl, prepared_points.cl): a work-group of G work-items
  * owns G * per_item consecutive vertices of the batch (patches first_patch .. first_patch +
  * num_patches - 1), and in step k its work-item l writes vertex k G + l of them, so each step's
- * stores are side by side.  A work-item finds and loads a patch only when its next vertex is in
- * another one: from prepared[p - first_patch] when from_prepared (a literal, so each kernel
+ * stores are side by side.  A work-item finds (patch_of) and loads a patch only when its next
+ * vertex is in another one: from prepared[p - first_patch] when from_prepared (a literal, so each kernel
  * keeps one of the two; no arithmetic), else by kind_load from controls.  Work-items past the
  * batch's last vertex stop. */
 ALWAYS_INLINE void put_points(__global const float4 *controls, uint patch_base, const int from_prepared,
@@ -145,7 +136,7 @@ ALWAYS_INLINE void put_points(__global const float4 *controls, uint patch_base, 
     kind_patch patch;
     for (uint k = 0; k < per_item && at < end; ++k, at += group) {
         if (at >= patch_end) {
-            p = patch_end ? next_patch_of(vertex_offsets, p, last, at) : patch_of(vertex_offsets, p, last, at);
+            p = patch_of(vertex_offsets, p, last, at);  /* a binary search from the last patch on */
             patch_start = vertex_offsets[p];
             patch_end = vertex_offsets[p + 1];
             f = patch_factors(factors[p], &collapsed);

@@ -4,7 +4,7 @@
  * work-item write its own run.  A work-group of G work-items owns G * per_item consecutive
  * vertices of the batch; in step k its work-item l writes vertex k G + l of them, so each step's
  * stores are side by side, and a work-item finds and loads a patch only when its next vertex is
- * in another one (put_points in stages/rows.h: the next patch, else a binary search).  Each
+ * in another one (put_points in stages/rows.h: a binary search over vertex_offsets).  Each
  * vertex is put_point's (stages/rows.h): bitwise what stages/vertices.cl writes, forward
  * differencing included (replayed from the row's start).  The batch is patches first_patch ..
  * first_patch + num_patches - 1; work-items past its last vertex stop, so the host may launch
