@@ -1,5 +1,9 @@
 """The error bound is kept: |surface(u,v) - mesh(u,v)| <= eps, sampled densely inside every
-output triangle (transition strips included), both taken at the same (u, v)."""
+output triangle, both taken at the same (u, v), with every pattern family whose factors come from
+the bound: the transition pattern (its transition strips included) and the semi-uniform patterns
+(issue 11: stage 1 rounds every factor up to 2^p_e, no cap reached since max_level >= log2
+max_factor, so each edge keeps at least the factor its bound asks for; the snapped triangles
+along an edge below the patch's level are the ones the bound must also hold for)."""
 from pathlib import Path
 
 import numpy as np
@@ -14,117 +18,117 @@ from support import as_float32, bound_ratio, closed_torus_grid, random_patches
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
 
 
-def check_bound(tessellator, scene, name, eps=None, pixels=None, max_factor=64):
-    tess = tessellator.tessellate(scene, eps=eps, pixels=pixels, max_factor=max_factor)
+@pytest.fixture(params=["transition", "semi_uniform"])
+def pattern(request):
+    return request.param
+
+
+def uneven_patches(factors, edges):
+    """Patches whose edge factors differ: transition strips, or (semi-uniform) snapped edges."""
+    f = factors[:, :edges]
+    return int(((f.min(1) < f.max(1)) & (f.min(1) > 0)).sum())
+
+
+def check_bound(tessellator, scene, name, pattern, eps=None, pixels=None, max_factor=64, pn=False, **options):
+    """Tessellates scene with pattern, checks the bound; returns the tessellation and how many
+    patches have uneven edge factors (the triangles the plain grid does not have)."""
+    if pattern == "semi_uniform":
+        options["max_level"] = max(6, int(np.ceil(np.log2(max_factor))))
+    tess = tessellator.tessellate(scene, eps=eps, pixels=pixels, max_factor=max_factor, pattern=pattern, **options)
     assert tess.stats["saturated"] == 0, "choose a tolerance the factors can meet"
+    if pattern == "semi_uniform":
+        factors = tess.factors[tess.factors[:, 0] > 0]
+        assert (factors & (factors - 1) == 0).all(), "dyadic records"
+    if pn:
+        from cltess.pipeline import PN
+
+        patches = reference.pn_control_points(PN.prepare(scene, options.get("sharp_edges", "straight"))
+                                              .source.astype(np.float64))
+        surface, tolerances = reference.pn_surface_points, reference.pn_tolerances
+    else:
+        patches, surface, tolerances = as_float32(scene.patches), reference.surface_points, reference.patch_tolerances
     if pixels is not None:
-        eps, culled = reference.patch_tolerances(as_float32(scene.patches), pixels=pixels, camera=scene.camera)
+        eps, culled = tolerances(patches, pixels=pixels, camera=scene.camera)
         assert np.array_equal(tess.factors[:, 0] == 0, culled)
-    final = tess.factors
-    transition = ((final[:, 0] != final[:, 2]) | (final[:, 1] != final[:, 3])).sum()
-    ratio = bound_ratio(as_float32(scene.patches), tess, eps)
-    BOUND_RATIOS[f"{name} ({tess.num_triangles} triangles, {transition} patches with transitions)"] = ratio
-    print(f"{name}: worst ratio {ratio:.4f}, {transition} patches with transition strips")
+    uneven = uneven_patches(tess.factors, 3 if pn else 4)
+    ratio = bound_ratio(patches, tess, eps, surface=surface)
+    label = f"{'PN ' if pn else ''}{name}, {pattern}"
+    BOUND_RATIOS[f"{label} ({tess.num_triangles} triangles, {uneven} with uneven edges)"] = ratio
+    print(f"{label}: worst ratio {ratio:.4f}, {uneven} patches with uneven edges")
     assert ratio <= 1.0
-    return tess
+    return tess, uneven
 
 
 @pytest.mark.parametrize("eps", [0.05, 0.005])
-def test_bound_on_the_teapot(tessellator, eps):
-    check_bound(tessellator, load_scene(SCENES / "teapot.bez"), f"teapot eps={eps}", eps=eps)
+def test_bound_on_the_teapot(tessellator, pattern, eps):
+    _, uneven = check_bound(tessellator, load_scene(SCENES / "teapot.bez"), f"teapot eps={eps}", pattern, eps=eps)
+    assert uneven > 0
 
 
 @pytest.mark.parametrize("name", ["teacup.bez", "teaspoon.bez", "sphere.bpt", "torus.bpt"])
-def test_bound_on_bundled_models(tessellator, name):
+def test_bound_on_bundled_models(tessellator, pattern, name):
     scene = load_scene(SCENES / name)
     size = np.ptp(scene.points.reshape(-1, 3), axis=0).max()
-    check_bound(tessellator, scene, f"{name} eps={size * 1e-3:.2g}", eps=size * 1e-3)
+    check_bound(tessellator, scene, f"{name} eps={size * 1e-3:.2g}", pattern, eps=size * 1e-3)
 
 
 @pytest.mark.parametrize("eps", [0.3, 0.1])
-def test_bound_on_a_closed_grid_with_random_weights(tessellator, rng, eps):
-    tess = check_bound(tessellator, closed_torus_grid(rng, 10, 6, noise=0.1), f"random torus grid eps={eps}",
-                       eps=eps, max_factor=512)
-    assert ((tess.factors[:, 0] != tess.factors[:, 2]) | (tess.factors[:, 1] != tess.factors[:, 3])).any()
+def test_bound_on_a_closed_grid_with_random_weights(tessellator, pattern, rng, eps):
+    _, uneven = check_bound(tessellator, closed_torus_grid(rng, 10, 6, noise=0.1), f"random torus grid eps={eps}",
+                            pattern, eps=eps, max_factor=512)
+    assert uneven > 0
 
 
 @pytest.mark.parametrize("eps", [0.2, 0.03])
-def test_bound_on_random_rational_patches(tessellator, rng, eps):
+def test_bound_on_random_rational_patches(tessellator, pattern, rng, eps):
     scene = Scene(random_patches(rng, 20), np.zeros(20, np.int32), name="random patches")
-    check_bound(tessellator, scene, f"random rational patches eps={eps}", eps=eps, max_factor=4096)
+    check_bound(tessellator, scene, f"random rational patches eps={eps}", pattern, eps=eps, max_factor=4096)
 
 
-def test_bound_in_screen_space_with_culling(tessellator, rng):
+def test_bound_in_screen_space_with_culling(tessellator, pattern, rng):
     patches = random_patches(rng, 150, spread=3.0)  # weights 0.2 to 5
     camera = Camera(eye=np.array([12.0, 2.0, 1.0]), target=np.zeros(3), fov_y_deg=30, width=200, height=150)
     scene = Scene(patches, np.zeros(150, np.int32), camera, name="random patches")
-    tess = check_bound(tessellator, scene, "random patches, 16 px", pixels=16.0, max_factor=512)
-    assert 0 < tess.stats["culled"] < 150
+    tess, uneven = check_bound(tessellator, scene, "random patches, 16 px", pattern, pixels=16.0, max_factor=512)
+    assert 0 < tess.stats["culled"] < 150 and uneven > 0
 
 
 # --- PN triangles: the surface is the PN patch of each input triangle, at the same (u, v) --------
 
-def check_pn_bound(tessellator, scene, name, eps=None, pixels=None, max_factor=64, sharp_edges="straight"):
-    from cltess.pipeline import PN
-
-    tess = tessellator.tessellate(scene, eps=eps, pixels=pixels, max_factor=max_factor, sharp_edges=sharp_edges)
-    assert tess.stats["saturated"] == 0, "choose a tolerance the factors can meet"
-    controls = reference.pn_control_points(PN.prepare(scene, sharp_edges).source.astype(np.float64))
-    if pixels is not None:
-        eps, culled = reference.pn_tolerances(controls, pixels=pixels, camera=scene.camera)
-        assert np.array_equal(tess.factors[:, 0] == 0, culled)
-    f = tess.factors[:, :3]
-    transition = ((f.min(1) != f.max(1)) & (f.min(1) > 0)).sum()
-    ratio = bound_ratio(controls, tess, eps, surface=reference.pn_surface_points)
-    BOUND_RATIOS[f"PN {name} ({tess.num_triangles} triangles, {transition} with transitions)"] = ratio
-    print(f"PN {name}: worst ratio {ratio:.4f}, {transition} triangles with transition strips")
-    assert ratio <= 1.0
-    assert transition > 0
-    return tess
-
-
-def mesh_scene(mesh, name, camera=None):
-    return Scene.from_trimesh(mesh, camera=camera, name=name)
-
-
-@pytest.mark.parametrize("eps", [1e-2, 1e-3])
-def test_pn_bound_on_an_icosphere(tessellator, eps):
-    from support import icosphere
-
-    check_pn_bound(tessellator, mesh_scene(icosphere(2), "icosphere"), f"icosphere eps={eps}", eps=eps)
-
-
 @pytest.mark.parametrize("eps", [3e-2, 3e-3])
-def test_pn_bound_on_a_torus_and_a_genus_2_mesh(tessellator, eps):
-    from support import genus2, torus
+def test_pn_bound_on_an_icosphere_a_torus_and_a_genus_2_mesh(tessellator, pattern, eps):
+    from support import genus2, icosphere, torus
 
-    check_pn_bound(tessellator, mesh_scene(torus(), "torus"), f"torus eps={eps}", eps=eps)
-    check_pn_bound(tessellator, mesh_scene(genus2(), "genus 2"), f"genus-2 eps={eps}", eps=eps)
+    uneven = sum(check_bound(tessellator, Scene.from_trimesh(mesh, name=name), f"{name} eps={eps}", pattern,
+                             eps=eps, pn=True)[1]
+                 for name, mesh in (("icosphere", icosphere(2)), ("torus", torus()), ("genus 2", genus2())))
+    assert uneven > 0
 
 
 @pytest.mark.parametrize("sharp_edges", ["straight", "average", "keep"])
-def test_pn_bound_on_a_noisy_mesh_with_sharp_edges(tessellator, rng, sharp_edges):
-    """Random vertex noise (factors vary a lot between neighbours: many transitions) and split
+def test_pn_bound_on_a_noisy_mesh_with_sharp_edges(tessellator, pattern, rng, sharp_edges):
+    """Random vertex noise (factors vary a lot between neighbours: many uneven edges) and split
     vertices with perturbed normals (sharp edges), under each sharp-edge choice."""
     from support import icosphere, split_some_vertices
 
     mesh = icosphere(2)
     mesh = type(mesh)(mesh.vertices * rng.uniform(0.8, 1.2, (len(mesh.vertices), 1)), mesh.faces, process=False)
     mesh = split_some_vertices(rng, mesh, fraction=0.3, noise=0.3)
-    scene = mesh_scene(mesh, "noisy sphere")
-    tess = check_pn_bound(tessellator, scene, f"noisy split sphere eps=0.003 sharp={sharp_edges}", eps=0.003,
-                          sharp_edges=sharp_edges)
-    assert tess.stats["sharp_edges"] > 20
+    tess, uneven = check_bound(tessellator, Scene.from_trimesh(mesh, name="noisy sphere"),
+                               f"noisy split sphere eps=0.003 sharp={sharp_edges}", pattern, eps=0.003, pn=True,
+                               sharp_edges=sharp_edges)
+    assert tess.stats["sharp_edges"] > 20 and uneven > 0
 
 
-def test_pn_bound_in_screen_space_with_culling(tessellator):
+def test_pn_bound_in_screen_space_with_culling(tessellator, pattern):
     from support import genus2
 
     camera = Camera(eye=np.array([2.5, -2.0, 1.5]), target=np.array([2.5, 1.5, 0.5]), fov_y_deg=40,
                     width=400, height=300)
-    scene = mesh_scene(genus2(), "genus 2", camera)
-    tess = check_pn_bound(tessellator, scene, "genus-2, 0.5 px, camera inside", pixels=0.5, max_factor=256)
-    assert 0 < tess.stats["culled"] < scene.num_patches
+    scene = Scene.from_trimesh(genus2(), camera=camera, name="genus 2")
+    tess, uneven = check_bound(tessellator, scene, "genus-2, 0.5 px, camera inside", pattern, pixels=0.5,
+                               max_factor=256, pn=True)
+    assert 0 < tess.stats["culled"] < scene.num_patches and uneven > 0
 
 
 def far_pixel_scene(tmp_path, offset):
