@@ -399,9 +399,9 @@ ROWS_IN_PARALLEL = {"many_patches_by_rows": "many_patches", "pn_icosphere_by_row
                     "semi_uniform_by_rows": "semi_uniform", "collapsed_bottom_direct_by_rows": "collapsed_bottom_direct"}
 #: Scenarios whose stages 4-5 run a work-item per vertex and per triangle (Tessellator(work=
 #: "point"): stages/vertex_points.cl, stages/triangles.cl): forward differencing replayed per
-#: vertex, the quad grid's triangles by pattern_triangle_at (uniform), the per-patch fall-back
-#: (transitions, collapsed edges, PN, ESC), culled patches, two kinds, batches (one scenario per
-#: path: the suite's time, issue 15).
+#: vertex, the quad grid's triangles by pattern_triangle_at (uniform; collapsed edges: the teapot
+#: bottom's), the per-patch fall-back (transitions, PN, ESC), culled patches, two kinds, batches
+#: (one scenario per path: the suite's time, issue 15).
 POINTS = {"uniform_by_points": "uniform", "pn_icosphere_by_points": "pn_icosphere",
           "collapsed_bottom_direct_by_points": "collapsed_bottom_direct",
           "mixed_culled_by_points": "mixed_culled", "esc_by_points": "esc",

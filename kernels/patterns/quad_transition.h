@@ -100,21 +100,50 @@ inline void grid_cells(__global uint *out, uint *count, uint base, pattern_grid 
         }
 }
 
-/* Triangle t of a patch whose triangles are the plain A x B grid (uniform factors, no collapsed
- * edge): *triangle its local vertex numbers, as grid_cells emits them (cell t / 2 row by row,
- * then (a, b, c) and (a, c, d)).  Returns 0 for any other patch, whose triangles only
- * pattern_primitives makes.  Stage 5 a work-item per triangle (stages/triangles.cl) uses it. */
+/* Triangle t of a patch whose triangles are the plain A x B grid (uniform factors): *triangle
+ * its local vertex numbers, as grid_cells emits them (cells row by row, each (a, b, c) then
+ * (a, c, d), less those grid_cells leaves out on collapsed edges).  In row j the triangle slots
+ * are s = 2 i + h (h = 0: (a, b, c), 1: (a, c, d)); a collapsed edge 0 removes every h = 0 slot
+ * of row 0, edge 2 every h = 1 slot of row B - 1, edge 1 slot 2 (A - 1) of every row and edge 3
+ * slot 1; the k-th kept slot is found by stepping over the removed ones.  Returns 0 for any
+ * other patch, whose triangles only pattern_primitives makes.  Stage 5 a work-item per triangle
+ * (stages/triangles.cl) uses it; tests/test_triangle_at.py checks it against grid_cells for
+ * every collapsed mask. */
 #define PATTERN_TRIANGLE_AT 1
 inline int pattern_triangle_at(int4 f, int collapsed, uint t, __private uint3 *triangle)
 {
     pattern_grid g = quad_grid(f);
-    if (!g.uniform || collapsed)
+    if (!g.uniform)
         return 0;
-    uint cell = t >> 1;
-    int i = (int)(cell % (uint)g.core.x), j = (int)(cell / (uint)g.core.x);
+    int a_steps = g.core.x, b_steps = g.core.y;
+    uint c0 = collapsed & 1, c1 = (collapsed >> 1) & 1, c2 = (collapsed >> 2) & 1, c3 = (collapsed >> 3) & 1;
+    uint middle = 2 * (uint)a_steps - c1 - c3;  /* a row that touches neither edge 0 nor edge 2 */
+    uint first = (c0 ? 0 : (uint)a_steps - c1) + (b_steps == 1 && c2 ? 0 : (uint)a_steps - c3);
+    int j;
+    uint k;
+    if (t < first) {
+        j = 0;
+        k = t;
+    } else if (t - first < (uint)max(b_steps - 2, 0) * middle) {
+        j = 1 + (int)((t - first) / middle);
+        k = (t - first) % middle;
+    } else {
+        j = b_steps - 1;
+        k = t - first - (uint)max(b_steps - 2, 0) * middle;
+    }
+    uint s;
+    if (j == 0 && c0) {                  /* only (a, c, d) slots, less the first cell's on edge 3 */
+        s = 2 * (k + c3) + 1;
+    } else if (j == b_steps - 1 && c2) { /* only (a, b, c) slots, less the last cell's on edge 1 */
+        s = 2 * k;
+    } else {
+        s = k + (c3 && k >= 1);
+        s += c1 && s >= 2 * (uint)a_steps - 2;
+    }
+    int i = (int)(s >> 1);
     uint a = pattern_grid_index(g, (int2)(i, j)), c = pattern_grid_index(g, (int2)(i + 1, j + 1));
-    uint b = (t & 1) ? c : pattern_grid_index(g, (int2)(i + 1, j));
-    uint d = (t & 1) ? pattern_grid_index(g, (int2)(i, j + 1)) : c;
+    uint b = (s & 1) ? c : pattern_grid_index(g, (int2)(i + 1, j));
+    uint d = (s & 1) ? pattern_grid_index(g, (int2)(i, j + 1)) : c;
     *triangle = (uint3)(a, b, d);
     return 1;
 }
