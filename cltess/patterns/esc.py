@@ -94,6 +94,22 @@ BOUNDARY_EDGES = frozenset(c for e in PATCH_EDGE_COARSE for c in e)
 INTERIOR_EDGES = tuple(c for c in range(33) if c not in BOUNDARY_EDGES)
 
 
+#: Patch edge e's coarse corners (I, J), 0..3: v = 0, u = 1, v = 1, u = 0.
+ON_PATCH_EDGE = (lambda p: p[1] == 0, lambda p: p[0] == 3, lambda p: p[1] == 3, lambda p: p[0] == 0)
+
+
+def pole_edges(collapsed: int) -> tuple:
+    """**The pole rule** (docs/esc.md): the coarse edges that run into a collapsed patch edge (bit
+    e of `collapsed`: a pole), i.e. with an end on it and not lying on it.  Stage 1 inserts all
+    their candidates (criteria/esc_distance.h; kernels/patterns/esc.h esc_pole_edge), so the
+    coarse triangles along a pole are the uniform level-L pattern on their sides into the patch."""
+    def on(e, p):
+        return (collapsed >> e) & 1 and ON_PATCH_EDGE[e](p)
+    return tuple(c for c, (start, end) in enumerate(COARSE_EDGES)
+                 if any(on(e, start) or on(e, end) for e in range(4))
+                 and not any(on(e, start) and on(e, end) for e in range(4)))
+
+
 def reverse_bits(mask: int, count: int) -> int:
     """The `count` low bits of mask in reverse order."""
     return int(sum(((mask >> k) & 1) << (count - 1 - k) for k in range(count)))

@@ -26,6 +26,45 @@
 #define ESC_V(i, j) (12 + 3 * (i) + (j))
 #define ESC_D(i, j) (24 + 3 * (j) + (i))
 
+/* Coarse edge c's end corners (I, J) in its canonical direction (esc.py COARSE_EDGES). */
+inline void esc_coarse_ends(int c, __private int2 *start, __private int2 *end)
+{
+    if (c < 12) {
+        *start = (int2)(c % 3, c / 3);
+        *end = *start + (int2)(1, 0);
+    } else if (c < 24) {
+        *start = (int2)((c - 12) / 3, (c - 12) % 3);
+        *end = *start + (int2)(0, 1);
+    } else {
+        *start = (int2)((c - 24) % 3, (c - 24) / 3);
+        *end = *start + (int2)(1, 1);
+    }
+}
+
+/* Coarse edge number of segment s (counter-clockwise) of patch edge e (esc.py PATCH_EDGE_COARSE). */
+inline int esc_boundary_coarse(int e, int s) { return e == 0 ? s : e == 1 ? 21 + s : e == 2 ? 11 - s : 14 - s; }
+
+/* Is corner p on a pole, a patch edge of bit e in `poles`? */
+inline int esc_on_pole(int2 p, int poles, int e)
+{
+    return (poles >> e) & 1 && (e == 0 ? p.y == 0 : e == 1 ? p.x == 3 : e == 2 ? p.y == 3 : p.x == 0);
+}
+
+/* The pole rule (esc.py pole_edges; docs/esc.md): does coarse edge c run into a pole (an end on
+ * it, not lying on it)?  Stage 1 inserts all its candidates. */
+inline int esc_pole_edge(int c, int poles)
+{
+    int2 start, end;
+    esc_coarse_ends(c, &start, &end);
+    int touches = 0, lies = 0;
+    for (int e = 0; e < 4; ++e) {
+        int a = esc_on_pole(start, poles, e), b = esc_on_pole(end, poles, e);
+        touches |= a | b;
+        lies |= a & b;
+    }
+    return touches && !lies;
+}
+
 inline uint esc_reverse_bits(uint mask, int count)
 {
     uint out = 0;
