@@ -8,6 +8,7 @@
 #ifndef CLTESS_PATTERNS_ESC_H
 #define CLTESS_PATTERNS_ESC_H
 #include "common.h"
+#include "patterns/esc_counts.h"  /* generated: cltess/patterns/esc.py count_table_header */
 
 #define PATTERN_EDGES 4
 #define PATTERN_EDGE_POINTS(f, e) esc_ring_count(f, e)  /* the record is masks, not counts (patterns/layout.h) */
@@ -272,10 +273,9 @@ inline uint esc_index(__private const esc_patch *g, int2 p)
 /* Coarse triangle t (0..17: cell (i, j) = (t/2 % 3, t/6), lower then upper): apex, B0, B1 in
  * coarse units and its left (A->B0), right (A->B1) and base (B0->B1) masks, counter-clockwise
  * order (esc.py COARSE_TRIANGLES). */
-inline void esc_coarse(__private const esc_patch *g, int t, __private int2 corner[3], __private uint bits[3])
+inline void esc_coarse(__private const esc_record *r, int t, __private int2 corner[3], __private uint bits[3])
 {
-    int cell = t / 2, i = cell % 3, j = cell / 3, level = g->r.level;
-    __private const esc_record *r = &g->r;
+    int cell = t / 2, i = cell % 3, j = cell / 3, level = r->level;
     if ((t & 1) == 0) {
         corner[0] = (int2)(i + 1, j);
         corner[1] = (int2)(i + 1, j + 1);
@@ -404,7 +404,7 @@ inline void esc_coarse_triangle(__private const esc_patch *g, int t, __private e
 {
     int2 corner[3], upper[ESC_MAX_LEVEL + 3], lower[ESC_MAX_LEVEL + 3];  /* chains, right to left */
     uint bits[3];
-    esc_coarse(g, t, corner, bits);
+    esc_coarse(&g->r, t, corner, bits);
     int n = g->r.n, a = 0, upper_length = 1;
     upper[0] = (int2)(0, 0);
     for (int b = 1; b <= n; ++b) {
@@ -479,9 +479,47 @@ inline void esc_walk(int4 f, int collapsed, __private esc_writer *w)
         esc_coarse_triangle(&g, t, w);
 }
 
-/* Triangles ("count" mode when out == 0, "emit" otherwise). */
+/* Stage 3's counts from the masks alone (esc.py counts): each coarse triangle's row of the
+ * generated table (its triangles and strip indices as esc_coarse_triangle walks them; checked
+ * exhaustively against the walk, tests/test_esc_counts.py), less, for a side on a collapsed edge,
+ * its popcount + 1 segments (each one triangle's side; those have two points in one and are left
+ * out).  Two adjacent collapsed edges (their shared corner is one edge's point only): 0, the
+ * caller walks. */
+inline int esc_table_counts(int4 f, int collapsed, __private uint *triangles, __private uint *strip_indices)
+{
+    *triangles = *strip_indices = 0;
+    if (f.s0 <= 0)
+        return 1;
+    if (collapsed & ((collapsed << 1) | (collapsed >> 3)) & 15)
+        return 0;
+    esc_record r = esc_read(f);
+    int level = r.level;
+    __constant const uchar *tris = ESC_TABLE_TRIANGLES + ESC_TABLE_START[level];
+    __constant const uchar *strips = ESC_TABLE_STRIP_INDICES + ESC_TABLE_START[level];
+    for (int t = 0; t < 18; ++t) {
+        int2 corner[3];
+        uint bits[3];
+        esc_coarse(&r, t, corner, bits);
+        uint row = bits[0] | bits[1] << level | bits[2] << (2 * level);
+        *triangles += tris[row];
+        *strip_indices += strips[row];
+        for (int side = 0; collapsed && side < 2; ++side) {
+            int on = 0;
+            for (int e = 0; e < 4; ++e)
+                on |= esc_on_pole(corner[0], collapsed, e) && esc_on_pole(corner[1 + side], collapsed, e);
+            if (on)
+                *triangles -= popcount(bits[side]) + 1;
+        }
+    }
+    return 1;
+}
+
+/* Triangles ("count" mode when out == 0: the table, else the walk; "emit" otherwise). */
 inline uint pattern_primitives(int4 f, int collapsed, __global uint *out, uint base)
 {
+    uint triangles, strip_indices;
+    if (!out && esc_table_counts(f, collapsed, &triangles, &strip_indices))
+        return triangles;
     esc_writer w;
     w.triangles = out;
     w.strips = 0;
@@ -497,6 +535,9 @@ inline uint pattern_primitives(int4 f, int collapsed, __global uint *out, uint b
  * strip_indices.cl; cltess/backends/opencl/strips.py). */
 inline uint pattern_strips(int4 f, int collapsed, __global uint *out, uint base)
 {
+    uint triangles, strip_indices;
+    if (!out && esc_table_counts(f, collapsed, &triangles, &strip_indices))
+        return strip_indices;
     esc_writer w;
     w.triangles = 0;
     w.strips = out;
