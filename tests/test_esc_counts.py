@@ -84,3 +84,40 @@ def test_device_counts_equal_the_emission_and_the_mirror(tessellator, rng):
     firsts = vertex_offsets.get()
     expected = np.concatenate([esc.layout(f)[1] + firsts[p] for p, f in enumerate(factors)])
     assert np.array_equal(triangles.get().reshape(-1, 3), expected)
+
+
+def test_the_strip_table_decodes_to_the_strips():
+    """Row r's coded points, split at the restarts, are coarse_triangle's strips in order."""
+    points, first = esc.strip_table()
+    table = esc.count_table()
+    row = 0
+    for level in range(4):
+        for mask in range(1 << 3 * level):
+            coded = points[first[row]:first[row] + table[row, 1]]
+            strips = esc.coarse_triangle(level, *esc.triangle_bits(mask, level))[2]
+            expected = [c for s in strips for c in [j * esc.STRIP_POINT_BASE + i for j, i in s] + [esc.STRIP_TABLE_RESTART]]
+            assert coded.tolist() == expected
+            row += 1
+    assert first[-1] + table[-1, 1] == len(points) and len(points) < 1 << 16  # ushort offsets
+
+
+def test_device_table_strips_and_counts_equal_the_walk(tessellator, rng):
+    """The table path (esc) against the walk (esc.ESC_COUNTS_WALK: counts and strips zipped band
+    by band) on the device: bitwise the same counts, strips and triangles."""
+    from cltess.patterns import PATTERNS
+    PATTERNS.setdefault(esc.ESC_COUNTS_WALK.name, esc.ESC_COUNTS_WALK)
+    factors = records_with_every_collapse(rng, 320)
+    count = len(factors)
+    device = cl_array.to_device(tessellator.queue, factors)
+    results = []
+    for pattern in (esc.ESC, esc.ESC_COUNTS_WALK):
+        vertex_offsets, index_offsets, _ = tessellator.stage_counts(device, [(pattern, 0, count)])
+        part = SimpleNamespace(pattern=pattern, base=0, count=count)
+        offsets, _ = strip_offsets(tessellator, device, [part])
+        plan = SimpleNamespace(num_patches=count, num_strip_indices=int(offsets[count].get()), strip_offsets=offsets,
+                               parts=[part], factors=device, vertex_offsets=vertex_offsets)
+        strips, _ = emit_strips(tessellator, plan, 0, count)
+        middle, _ = emit_strips(tessellator, plan, 37, 211)
+        results.append((index_offsets.get(), offsets.get(), strips, middle))
+    for table, walk in zip(*results):
+        assert np.array_equal(table, walk)

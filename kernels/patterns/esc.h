@@ -488,6 +488,9 @@ inline void esc_walk(int4 f, int collapsed, __private esc_writer *w)
 inline int esc_table_counts(int4 f, int collapsed, __private uint *triangles, __private uint *strip_indices)
 {
     *triangles = *strip_indices = 0;
+#ifdef ESC_COUNTS_WALK
+    return 0;  /* patterns/esc_walk.h: the baseline of bench/esc.py --stages */
+#endif
     if (f.s0 <= 0)
         return 1;
     if (collapsed & ((collapsed << 1) | (collapsed >> 3)) & 15)
@@ -530,6 +533,32 @@ inline uint pattern_primitives(int4 f, int collapsed, __global uint *out, uint b
     return w.triangle_count;
 }
 
+/* Stage 5's strips from the table (esc.py strip_table: coarse_triangle's strips, each band's
+ * points in order, rule-4 copies included) through the patch's vertex numbering: the walk's
+ * strips without zipping the bands again (tests: equal to the walk and the mirror). */
+inline uint esc_table_strips(int4 f, int collapsed, __global uint *out, uint base)
+{
+    if (f.s0 <= 0)
+        return 0;
+    esc_patch g;
+    esc_setup(f, collapsed, &g);
+    int level = g.r.level, n = g.r.n;
+    uint at = 0;
+    for (int t = 0; t < 18; ++t) {
+        int2 corner[3];
+        uint bits[3];
+        esc_coarse(&g.r, t, corner, bits);
+        int row = ESC_TABLE_START[level] + (int)(bits[0] | bits[1] << level | bits[2] << (2 * level));
+        __constant const uchar *points = ESC_TABLE_STRIP_POINTS + ESC_TABLE_STRIP_FIRST[row];
+        for (int k = 0, count = ESC_TABLE_STRIP_INDICES[row]; k < count; ++k) {
+            int code = points[k];
+            out[at++] = code == ESC_STRIP_TABLE_RESTART ? STRIP_RESTART
+                : base + esc_index(&g, esc_lattice(corner, n, (int2)(code / ESC_STRIP_POINT_BASE, code % ESC_STRIP_POINT_BASE)));
+        }
+    }
+    return at;
+}
+
 /* Strip indices, each strip followed by STRIP_RESTART (count mode when out == 0): one strip per
  * band of a coarse triangle, esc.py patch_mesh's strips in its order (stages/strip_counts.cl,
  * strip_indices.cl; cltess/backends/opencl/strips.py). */
@@ -538,6 +567,10 @@ inline uint pattern_strips(int4 f, int collapsed, __global uint *out, uint base)
     uint triangles, strip_indices;
     if (!out && esc_table_counts(f, collapsed, &triangles, &strip_indices))
         return strip_indices;
+#ifndef ESC_COUNTS_WALK
+    if (out)
+        return esc_table_strips(f, collapsed, out, base);
+#endif
     esc_writer w;
     w.triangles = 0;
     w.strips = out;
