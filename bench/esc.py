@@ -210,18 +210,18 @@ STAGES = ("factors", "crack_free", "counts", "vertices", "indices", "strips")
 
 
 def stage_rows(tessellator, scene, repeat: int) -> list[dict]:
-    """ESC's stages on Teacups (--stages): the counts from the table (esc, as it is) against the
-    counts walked (esc.ESC_COUNTS_WALK, the build before the table), each stage's median device
+    """ESC's stages on Teacups (--stages): counts, triangles and strips from the tables (esc, as it
+    is) against the walk (esc.ESC_WALK, the build before the tables), each stage's median device
     ms of --repeat runs after a warm-up, both in this run; the same strips and triangles asserted."""
     from cltess.patterns import PATTERNS
-    from cltess.patterns.esc import ESC_COUNTS_WALK
-    PATTERNS.setdefault(ESC_COUNTS_WALK.name, ESC_COUNTS_WALK)  # not in the registry: the baseline only
+    from cltess.patterns.esc import ESC_WALK
+    PATTERNS.setdefault(ESC_WALK.name, ESC_WALK)  # not in the registry: the baseline only
     rows = []
     print(f"  {'eps':<14} {'counts':<8} {'triangles':>10} {'strip idx':>10}  " +
           " ".join(f"{s:>9}" for s in STAGES) + f" {'stages 1-5':>10}")
     for label, eps in STAGE_EPS:
         results = {}
-        for counts, pattern in (("walk", ESC_COUNTS_WALK.name), ("table", "esc")):
+        for counts, pattern in (("walk", ESC_WALK.name), ("table", "esc")):
             request = Request.of(eps=eps, pattern=pattern, max_level=3)
             tessellator.tessellate(scene, request)
             runs = [tessellator.tessellate(scene, request) for _ in range(repeat)]
@@ -306,7 +306,7 @@ def main(argv=None) -> int:
     parser.add_argument("--levels", action="store_true",
                         help="only per-patch levels against one level per run (docs/esc.md decision 5)")
     parser.add_argument("--stages", action="store_true",
-                        help="only ESC's stage times on Teacups, counts from the table against walked")
+                        help="only ESC's stage times on Teacups, from the tables against the walk")
     parser.add_argument("--json", type=Path)
     parser.add_argument("--csv", type=Path, help="the triangles-against-error points")
     parser.add_argument("--plot", type=Path, help="PNG of triangles against error (needs matplotlib)")

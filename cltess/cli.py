@@ -265,7 +265,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--weld", action=argparse.BooleanOptionalAction, default=None,
                      help="write one indexed mesh per object, shared boundary vertices merged exactly "
                           f"(default for {', '.join(MESH_FORMATS)}; --no-weld: every patch's own vertices, "
-                          "streamed in batches when large; .npz: the Tessellation's arrays unless --weld)")
+                          "streamed in batches when large, .npz too; .npz: the Tessellation's arrays unless --weld)")
     run.add_argument("--uv", choices=("drop", "seam"), default="drop",
                      help="welded output: drop the per-patch (u, v) (default) or keep them per triangle "
                           "corner as a seam (.ply face texcoord, .obj vt)")

@@ -1,7 +1,8 @@
-"""ESC's stage 3 counts from a table of the coarse-triangle masks (kernels/patterns/esc_counts.h,
-generated from cltess/patterns/esc.py count_table): the header is the generator's output, the table
-sums equal the walked pattern for every collapsed-edge combination, and on the device the counts
-equal what stage 5 emits (docs/esc.md "Counts from the masks alone")."""
+"""ESC's stage 3 counts and stage 5 triangles and strips from tables of the coarse-triangle masks
+(kernels/patterns/esc_counts.h, generated from cltess/patterns/esc.py): the header is the
+generator's output, the tables are the mirror's coarse triangles, the table sums equal the walked
+pattern for every collapsed-edge combination, and on the device the tables give bitwise what the
+walk gives (docs/esc.md "Counts and emission from tables")."""
 from types import SimpleNamespace
 
 import numpy as np
@@ -101,16 +102,29 @@ def test_the_strip_table_decodes_to_the_strips():
     assert first[-1] + table[-1, 1] == len(points) and len(points) < 1 << 16  # ushort offsets
 
 
+def test_the_triangle_table_decodes_to_the_triangles():
+    points, first = esc.triangle_table()
+    table = esc.count_table()
+    row = 0
+    for level in range(4):
+        for mask in range(1 << 3 * level):
+            coded = points[first[row]:first[row] + 3 * table[row, 0]].reshape(-1, 3)
+            triangles = esc.coarse_triangle(level, *esc.triangle_bits(mask, level))[1]
+            assert coded.tolist() == [[j * esc.STRIP_POINT_BASE + i for j, i in t] for t in triangles]
+            row += 1
+    assert len(points) == 3 * table[:, 0].sum() < 1 << 16
+
+
 def test_device_table_strips_and_counts_equal_the_walk(tessellator, rng):
-    """The table path (esc) against the walk (esc.ESC_COUNTS_WALK: counts and strips zipped band
-    by band) on the device: bitwise the same counts, strips and triangles."""
+    """The table path (esc) against the walk (esc.ESC_WALK: counts, triangles and strips zipped
+    band by band) on the device: bitwise the same counts, strips and triangles."""
     from cltess.patterns import PATTERNS
-    PATTERNS.setdefault(esc.ESC_COUNTS_WALK.name, esc.ESC_COUNTS_WALK)
+    PATTERNS.setdefault(esc.ESC_WALK.name, esc.ESC_WALK)
     factors = records_with_every_collapse(rng, 320)
     count = len(factors)
     device = cl_array.to_device(tessellator.queue, factors)
     results = []
-    for pattern in (esc.ESC, esc.ESC_COUNTS_WALK):
+    for pattern in (esc.ESC, esc.ESC_WALK):
         vertex_offsets, index_offsets, _ = tessellator.stage_counts(device, [(pattern, 0, count)])
         part = SimpleNamespace(pattern=pattern, base=0, count=count)
         offsets, _ = strip_offsets(tessellator, device, [part])
@@ -118,6 +132,9 @@ def test_device_table_strips_and_counts_equal_the_walk(tessellator, rng):
                                parts=[part], factors=device, vertex_offsets=vertex_offsets)
         strips, _ = emit_strips(tessellator, plan, 0, count)
         middle, _ = emit_strips(tessellator, plan, 37, 211)
-        results.append((index_offsets.get(), offsets.get(), strips, middle))
+        total = int(index_offsets[count].get())
+        triangles, _ = tessellator.stage_indices(device, vertex_offsets, index_offsets, (0, total), (0, count),
+                                                 kind=pattern)
+        results.append((index_offsets.get(), offsets.get(), strips, middle, triangles.get()))
     for table, walk in zip(*results):
         assert np.array_equal(table, walk)

@@ -243,10 +243,25 @@ def strip_table() -> tuple[np.ndarray, np.ndarray]:
     return np.array(points, np.uint8), np.array(first, np.int64)
 
 
+@lru_cache(maxsize=None)
+def triangle_table() -> tuple[np.ndarray, np.ndarray]:
+    """(points (N,) uint8, first (585,) int): every row's triangles (coarse_triangle's, in order)
+    as 3 coded points each, row r's from first[r] (3 count_table()[r, 0] of them).  Stage 5's
+    triangle list maps them through the patch's vertex numbering (esc.h esc_table_triangles)."""
+    points, first = [], []
+    for level in range(MAX_LEVEL + 1):
+        for mask in range(1 << 3 * level):
+            first.append(len(points))
+            for triangle in coarse_triangle(level, *triangle_bits(mask, level))[1]:
+                points.extend(j * STRIP_POINT_BASE + i for j, i in triangle)
+    return np.array(points, np.uint8), np.array(first, np.int64)
+
+
 def count_table_header() -> str:
     """The text of kernels/patterns/esc_counts.h (tests/test_esc_counts.py checks the file equals it)."""
     table = count_table()
     points, first = strip_table()
+    triangle_points, triangle_first = triangle_table()
 
     def lines(values):
         values = [str(int(v)) for v in values]
@@ -260,7 +275,7 @@ def count_table_header() -> str:
         " *   python -c \"from cltess.patterns import esc; esc.write_count_table_header()\"\n"
         " * Per coarse-triangle mask (row ESC_TABLE_START[L] + left | right << L | base << 2L): its\n"
         " * triangles and its strip indices (one restart per strip), as esc_coarse_triangle walks them;\n"
-        " * and its strips' points. */\n"
+        " * and its strips' and triangles' points. */\n"
         "#ifndef CLTESS_PATTERNS_ESC_COUNTS_H\n#define CLTESS_PATTERNS_ESC_COUNTS_H\n\n"
         f"__constant int ESC_TABLE_START[4] = {{{', '.join(map(str, TABLE_START))}}};\n\n"
         f"__constant uchar ESC_TABLE_TRIANGLES[{TABLE_ROWS}] = {{\n{rows(0)}}};\n\n"
@@ -269,7 +284,11 @@ def count_table_header() -> str:
         " * from ESC_TABLE_STRIP_FIRST[row] (esc.py strip_table). */\n"
         f"#define ESC_STRIP_POINT_BASE {STRIP_POINT_BASE}\n#define ESC_STRIP_TABLE_RESTART {STRIP_TABLE_RESTART}\n\n"
         f"__constant ushort ESC_TABLE_STRIP_FIRST[{TABLE_ROWS}] = {{\n{lines(first)}}};\n\n"
-        f"__constant uchar ESC_TABLE_STRIP_POINTS[{len(points)}] = {{\n{lines(points)}}};\n\n#endif\n")
+        f"__constant uchar ESC_TABLE_STRIP_POINTS[{len(points)}] = {{\n{lines(points)}}};\n\n"
+        "/* Each row's triangles, 3 coded points each, from ESC_TABLE_TRIANGLE_FIRST[row] (esc.py triangle_table). */\n"
+        f"__constant ushort ESC_TABLE_TRIANGLE_FIRST[{TABLE_ROWS}] = {{\n{lines(triangle_first)}}};\n\n"
+        f"__constant uchar ESC_TABLE_TRIANGLE_POINTS[{len(triangle_points)}] = {{\n{lines(triangle_points)}}};\n\n"
+        "#endif\n")
 
 
 def write_count_table_header() -> None:
@@ -480,8 +499,8 @@ ESC_ONE_LEVEL = Pattern("esc_one_level", "quad", 4, "patterns/esc.h", layout, cr
                         primitive="strips", stage1=((("PATTERN_ESC", 1), ("ESC_ONE_LEVEL", 1)), _stage1_one_level),
                         strips=strip_indices, counts_walk=True)
 
-#: ESC with stage 3's counts walked instead of read from the table (kernels/patterns/esc_walk.h):
-#: not in the registry; bench/esc.py --stages adds it to PATTERNS to measure what the table buys.
-ESC_COUNTS_WALK = Pattern("esc_counts_walk", "quad", 4, "patterns/esc_walk.h", layout, crack="crack/or_masks.h",
+#: ESC as before the tables (kernels/patterns/esc_walk.h): stage 3's counts and stage 5's triangles
+#: and strips walked band by band; not in the registry: bench/esc.py --stages adds it to PATTERNS.
+ESC_WALK = Pattern("esc_walk", "quad", 4, "patterns/esc_walk.h", layout, crack="crack/or_masks.h",
                           primitive="strips", stage1=((("PATTERN_ESC", 1),), _stage1), strips=strip_indices,
                           counts_walk=True)

@@ -488,7 +488,7 @@ inline void esc_walk(int4 f, int collapsed, __private esc_writer *w)
 inline int esc_table_counts(int4 f, int collapsed, __private uint *triangles, __private uint *strip_indices)
 {
     *triangles = *strip_indices = 0;
-#ifdef ESC_COUNTS_WALK
+#ifdef ESC_WALK
     return 0;  /* patterns/esc_walk.h: the baseline of bench/esc.py --stages */
 #endif
     if (f.s0 <= 0)
@@ -517,12 +517,45 @@ inline int esc_table_counts(int4 f, int collapsed, __private uint *triangles, __
     return 1;
 }
 
-/* Triangles ("count" mode when out == 0: the table, else the walk; "emit" otherwise). */
+/* Stage 5's triangle list from the table (esc.py triangle_table: coarse_triangle's triangles in
+ * order) through the patch's vertex numbering, a triangle with two points in one (a side on a
+ * collapsed edge) left out as the walk does; counted only when out == 0. */
+inline uint esc_table_triangles(int4 f, int collapsed, __global uint *out, uint base)
+{
+    if (f.s0 <= 0)
+        return 0;
+    esc_patch g;
+    esc_setup(f, collapsed, &g);
+    int level = g.r.level, n = g.r.n;
+    uint count = 0;
+    for (int t = 0; t < 18; ++t) {
+        int2 corner[3];
+        uint bits[3];
+        esc_coarse(&g.r, t, corner, bits);
+        int row = ESC_TABLE_START[level] + (int)(bits[0] | bits[1] << level | bits[2] << (2 * level));
+        __constant const uchar *points = ESC_TABLE_TRIANGLE_POINTS + ESC_TABLE_TRIANGLE_FIRST[row];
+        for (int k = 0, end = 3 * ESC_TABLE_TRIANGLES[row]; k < end; k += 3) {
+            uint index[3];
+            for (int c = 0; c < 3; ++c)
+                index[c] = esc_index(&g, esc_lattice(corner, n, (int2)(points[k + c] / ESC_STRIP_POINT_BASE,
+                                                                          points[k + c] % ESC_STRIP_POINT_BASE)));
+            if (index[0] != index[1] && index[1] != index[2] && index[0] != index[2])
+                put_triangle(out, &count, base, index[0], index[1], index[2]);
+        }
+    }
+    return count;
+}
+
+/* Triangles ("count" mode when out == 0: the table's sums, or, with two adjacent collapsed
+ * edges, the table's triangles through the numbering; "emit" otherwise). */
 inline uint pattern_primitives(int4 f, int collapsed, __global uint *out, uint base)
 {
     uint triangles, strip_indices;
     if (!out && esc_table_counts(f, collapsed, &triangles, &strip_indices))
         return triangles;
+#ifndef ESC_WALK
+    return esc_table_triangles(f, collapsed, out, base);
+#endif
     esc_writer w;
     w.triangles = out;
     w.strips = 0;
@@ -550,11 +583,13 @@ inline uint esc_table_strips(int4 f, int collapsed, __global uint *out, uint bas
         esc_coarse(&g.r, t, corner, bits);
         int row = ESC_TABLE_START[level] + (int)(bits[0] | bits[1] << level | bits[2] << (2 * level));
         __constant const uchar *points = ESC_TABLE_STRIP_POINTS + ESC_TABLE_STRIP_FIRST[row];
-        for (int k = 0, count = ESC_TABLE_STRIP_INDICES[row]; k < count; ++k) {
+        int count = ESC_TABLE_STRIP_INDICES[row];
+        for (int k = 0; out && k < count; ++k) {
             int code = points[k];
-            out[at++] = code == ESC_STRIP_TABLE_RESTART ? STRIP_RESTART
+            out[at + k] = code == ESC_STRIP_TABLE_RESTART ? STRIP_RESTART
                 : base + esc_index(&g, esc_lattice(corner, n, (int2)(code / ESC_STRIP_POINT_BASE, code % ESC_STRIP_POINT_BASE)));
         }
+        at += count;
     }
     return at;
 }
@@ -567,9 +602,8 @@ inline uint pattern_strips(int4 f, int collapsed, __global uint *out, uint base)
     uint triangles, strip_indices;
     if (!out && esc_table_counts(f, collapsed, &triangles, &strip_indices))
         return strip_indices;
-#ifndef ESC_COUNTS_WALK
-    if (out)
-        return esc_table_strips(f, collapsed, out, base);
+#ifndef ESC_WALK
+    return esc_table_strips(f, collapsed, out, base);  /* out == 0 here: adjacent collapsed edges, counted */
 #endif
     esc_writer w;
     w.triangles = 0;
