@@ -216,7 +216,7 @@ def build_parser() -> argparse.ArgumentParser:
                              "else the first usable CPU device; see 'cltess devices')")
     shared.add_argument("--max-memory", type=_memory_size, metavar="SIZE",
                         help="cap on the memory the output may take at once (e.g. 512M, 2G); a larger "
-                             "output is tessellated in batches (streamed to a per-patch .ply or .obj). "
+                             "output is tessellated in batches (streamed to a per-patch .ply, .obj or .npz). "
                              "Default: half the device's memory")
     shared.add_argument("--sharp-edges", choices=("straight", "average", "keep", "crease"), default="straight",
                         help="meshes: an edge whose two sides have different vertex normals becomes a "
@@ -265,7 +265,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--weld", action=argparse.BooleanOptionalAction, default=None,
                      help="write one indexed mesh per object, shared boundary vertices merged exactly "
                           f"(default for {', '.join(MESH_FORMATS)}; --no-weld: every patch's own vertices, "
-                          "streamed in batches when large, .npz too; .npz: the Tessellation's arrays unless --weld)")
+                          "streamed in batches when large; .npz: the Tessellation's arrays unless --weld)")
     run.add_argument("--uv", choices=("drop", "seam"), default="drop",
                      help="welded output: drop the per-patch (u, v) (default) or keep them per triangle "
                           "corner as a seam (.ply face texcoord, .obj vt)")
