@@ -205,6 +205,39 @@ def stage_ms(tessellator, scene, request, repeat: int) -> tuple[float, float, ob
     return float(np.median(totals)), float(np.median(firsts)), tess
 
 
+STAGE_EPS = (("high", 0.00412), ("medium", 0.0142), ("non-adaptive", TIGHT))
+STAGES = ("factors", "crack_free", "counts", "vertices", "indices", "strips")
+
+
+def stage_rows(tessellator, scene, repeat: int) -> list[dict]:
+    """ESC's stages on Teacups (--stages): counts, triangles and strips from the tables (esc, as it
+    is) against the walk (esc.ESC_WALK, the build before the tables), each stage's median device
+    ms of --repeat runs after a warm-up, both in this run; the same strips and triangles asserted."""
+    from cltess.patterns import PATTERNS
+    from cltess.patterns.esc import ESC_WALK
+    PATTERNS.setdefault(ESC_WALK.name, ESC_WALK)  # not in the registry: the baseline only
+    rows = []
+    print(f"  {'eps':<14} {'counts':<8} {'triangles':>10} {'strip idx':>10}  " +
+          " ".join(f"{s:>9}" for s in STAGES) + f" {'stages 1-5':>10}")
+    for label, eps in STAGE_EPS:
+        results = {}
+        for counts, pattern in (("walk", ESC_WALK.name), ("table", "esc")):
+            request = Request.of(eps=eps, pattern=pattern, max_level=3)
+            tessellator.tessellate(scene, request)
+            runs = [tessellator.tessellate(scene, request) for _ in range(repeat)]
+            tess = runs[-1]
+            results[counts] = tess
+            ms = {s: float(np.median([r.stage_ms.get(s, 0.0) for r in runs])) for s in STAGES}
+            row = {"eps": label, "counts": counts, "triangles": len(tess.triangles), "strip_indices": len(tess.strips),
+                   "stage_ms": ms, "device_ms": float(np.median([device_ms(r) for r in runs]))}
+            rows.append(row)
+            print(f"  {label:<14} {counts:<8} {row['triangles']:>10,} {row['strip_indices']:>10,}  " +
+                  " ".join(f"{ms[s]:>9.2f}" for s in STAGES) + f" {row['device_ms']:>10.2f}")
+        assert np.array_equal(results["walk"].strips, results["table"].strips)
+        assert np.array_equal(results["walk"].triangles, results["table"].triangles)
+    return rows
+
+
 def level_rows(tessellator, scene, error_scene, eps_values, repeat: int, sample_triangles) -> list[dict]:
     """Per-patch levels against one level per run at each eps (module docstring)."""
     from cltess.criteria.zheng_sederberg import zs_factors
@@ -272,6 +305,8 @@ def main(argv=None) -> int:
     parser.add_argument("--evaluators-only", action="store_true", help="only the evaluator timings")
     parser.add_argument("--levels", action="store_true",
                         help="only per-patch levels against one level per run (docs/esc.md decision 5)")
+    parser.add_argument("--stages", action="store_true",
+                        help="only ESC's stage times on Teacups, from the tables against the walk")
     parser.add_argument("--json", type=Path)
     parser.add_argument("--csv", type=Path, help="the triangles-against-error points")
     parser.add_argument("--plot", type=Path, help="PNG of triangles against error (needs matplotlib)")
@@ -283,6 +318,13 @@ def main(argv=None) -> int:
     print(f"device: {tessellator.device.name.strip()}")
     started = time.perf_counter()
     cups, cup = teacups()
+    if args.stages:
+        print(cups.name, cups.num_patches, "patches; device ms per stage, median of", args.repeat)
+        rows = stage_rows(tessellator, cups, args.repeat)
+        if args.json:
+            args.json.write_text(json.dumps({"device": tessellator.device.name.strip(), "stages": rows}, indent=1))
+        print(f"wall {time.perf_counter() - started:.0f} s")
+        return 0
     if args.levels:
         print(cups.name, cups.num_patches, "patches; error on one teacup")
         rows = level_rows(tessellator, cups, cup, LEVEL_EPS["teacups"], args.repeat, None)

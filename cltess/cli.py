@@ -216,7 +216,7 @@ def build_parser() -> argparse.ArgumentParser:
                              "else the first usable CPU device; see 'cltess devices')")
     shared.add_argument("--max-memory", type=_memory_size, metavar="SIZE",
                         help="cap on the memory the output may take at once (e.g. 512M, 2G); a larger "
-                             "output is tessellated in batches (streamed to a per-patch .ply or .obj). "
+                             "output is tessellated in batches (streamed to a per-patch .ply, .obj or .npz). "
                              "Default: half the device's memory")
     shared.add_argument("--sharp-edges", choices=("straight", "average", "keep", "crease"), default="straight",
                         help="meshes: an edge whose two sides have different vertex normals becomes a "

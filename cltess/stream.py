@@ -4,7 +4,10 @@ Stages 1-3 run once for the whole scene (``Tessellator.plan``): the scan tells t
 before anything big is allocated.  The patches are then cut into consecutive batches whose
 output fits the budget; each batch runs stages 4-5 (``Tessellator.emit``) and is appended to a
 streaming PLY or OBJ writer.  The file is the same, byte for byte, as a single pass would
-write, and it appears only when complete (``io.writing.atomic_write``).
+write, and it appears only when complete (``io.writing.atomic_write``).  An .npz is streamed
+too (``io.npz.NpzWriter``: its arrays spooled to temporary files, then zipped): the same
+arrays as the single pass, a strip pattern's strips (SD-2, ESC) included; PLY and OBJ write
+the triangles, which are the strips expanded.
 
 Memory: batches are sized to a third of the budget.  Two batches' output buffers are alive at
 once (``_overlapped``: the device computes batch k+1 while the host writes batch k), and on a
@@ -25,11 +28,12 @@ import pyopencl as cl
 from .backends.opencl.tessellator import combine_verified
 from .limits import OutputTooLarge
 from .io.export import check_extension, export
+from .io.npz import NpzWriter
 from .io.obj import ObjWriter
 from .io.ply import PlyWriter
 
 COPIES_IN_FLIGHT = 3  # device buffers, host copy, writer records
-STREAMING_WRITERS = {".ply": PlyWriter, ".obj": ObjWriter}
+STREAMING_WRITERS = {".ply": PlyWriter, ".obj": ObjWriter, ".npz": NpzWriter}
 
 
 @dataclass
@@ -57,8 +61,8 @@ def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = 
 
     options: eps / pixels / max_factor / forward_differencing, as for ``Tessellator.tessellate``.
     weld: write one welded mesh (``cltess.weld``; ``uv`` "drop" or "seam"): it is built in
-    memory, so it must fit the budget in one batch, as must .stl, .glb and .npz output; .ply
-    and .obj without weld are streamed batch by batch.  on_plan(plan): called after stages 1-3,
+    memory, so it must fit the budget in one batch, as must .stl and .glb output; .ply, .obj
+    and .npz without weld are streamed batch by batch (.npz: every array, strips included).  on_plan(plan): called after stages 1-3,
     before anything big is allocated or written (to check or refuse the output size).
     on_batch(tess): called with each batch's Tessellation (per-patch vertices, before welding),
     e.g. to draw a preview.
@@ -77,10 +81,10 @@ def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = 
         ranges = plan.batch_ranges(max(budget // COPIES_IN_FLIGHT, 1))
     except OutputTooLarge as error:
         raise OutputTooLarge(f"{error} (a batch may take a third of the memory cap, {budget} bytes)") from None
-    if weld or extension not in STREAMING_WRITERS:
+    if weld or extension not in STREAMING_WRITERS or (extension == ".npz" and len(ranges) == 1):
         if len(ranges) > 1:
             why = "a welded mesh is built in memory" if weld else f"{extension} cannot be streamed"
-            fix = "give --no-weld to stream per-patch .ply or .obj" if weld else "write .ply or .obj"
+            fix = "give --no-weld to stream per-patch .ply, .obj or .npz" if weld else "write .ply, .obj or .npz"
             raise OutputTooLarge(f"{path}: the output ({plan.output_bytes} bytes) needs {len(ranges)} batches "
                                  f"under a budget of {budget} bytes, and {why}; {fix}, or raise the memory cap")
         tess = tessellator.emit(plan, 0, plan.num_patches, forward_differencing)
@@ -100,8 +104,11 @@ def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = 
     done, verified = [], []
     with STREAMING_WRITERS[extension](path, plan.num_vertices, plan.num_indices // 3) as writer:
         for batch in _overlapped(tessellator, plan, ranges, forward_differencing):
-            writer.write_vertices(batch)
-            writer.write_faces(batch.triangles)
+            if isinstance(writer, NpzWriter):  # every array, strips included
+                writer.write_batch(batch)
+            else:  # PLY, OBJ: the triangles (a strip pattern's strips expanded)
+                writer.write_vertices(batch)
+                writer.write_faces(batch.triangles)
             if on_batch is not None:
                 on_batch(batch)
             done.append((batch.stats["first_patch"], batch.stats["last_patch"]))
@@ -112,7 +119,10 @@ def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = 
             for stage, ms in batch.stage_ms.items():
                 stage_ms[stage] = ms if stage == "total_wall" else stage_ms.get(stage, 0.0) + ms
             del batch
-    return StreamResult(dict(plan.stats, **combine_verified(verified)), stage_ms, len(done), budget, path, done)
+        stats = dict(plan.stats, **combine_verified(verified))
+        if isinstance(writer, NpzWriter):
+            writer.set_meta(stats, stage_ms)
+    return StreamResult(stats, stage_ms, len(done), budget, path, done)
 
 
 def _overlapped(tessellator, plan, ranges, forward_differencing: bool):

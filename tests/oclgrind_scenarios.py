@@ -317,6 +317,15 @@ def esc_levels_strips():
     return teapot([0, 4, 8, 12, 16, 20, 21, 24]), dict(eps=0.1, pattern="esc")
 
 
+def esc_sphere_poles():
+    """ESC on four patches of the rational sphere, two with a pole (issue 14, third session):
+    stage 1's pole rule (criteria/esc_distance.h esc_pole_edge), stage 3's table counts less the
+    segments on a collapsed side (patterns/esc.h esc_table_counts) and stage 5's table strips
+    (esc_table_strips)."""
+    scene, _ = rational_sphere()
+    return scene, dict(eps=0.05, pattern="esc")
+
+
 SCENARIOS = {
     "uniform": uniform,
     "one_transition": one_transition,
@@ -347,6 +356,7 @@ SCENARIOS = {
     "esc": esc,
     "esc_collapsed_lid_screen": esc_collapsed_lid_screen,
     "esc_levels_strips": esc_levels_strips,
+    "esc_sphere_poles": esc_sphere_poles,
 }
 
 #: Scenarios whose tessellation is then measured on the device (Tessellator.verify,

@@ -234,7 +234,7 @@ def test_scenarios_reach_every_code_path(oclgrind, tmp_path_factory):
 
     from cltess.adjacency import edge_groups
 
-    for name in ("collapsed_lid", "collapsed_bottom_direct"):
+    for name in ("collapsed_lid", "collapsed_bottom_direct", "esc_sphere_poles"):
         scene, _ = scenarios.SCENARIOS[name]()
         assert edge_groups(scene.patches).collapsed > 0, name
     for name in scenarios.VERIFIED:  # stages/verify.cl ran, and measured something

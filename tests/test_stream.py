@@ -66,10 +66,11 @@ def test_streamed_files_equal_single_pass_files(tessellator, tmp_path, suffix):
     assert (tmp_path / f"a{suffix}").read_bytes() == (tmp_path / f"b{suffix}").read_bytes()
 
 
-def test_npz_that_does_not_fit_is_refused_before_writing(tessellator, tmp_path):
+@pytest.mark.parametrize("suffix", [".stl", ".glb"])
+def test_formats_that_do_not_stream_are_refused_before_writing(tessellator, tmp_path, suffix):
     scene = load_scene(SCENES / "teapot.bez")
     with pytest.raises(OutputTooLarge, match="cannot be streamed"):
-        tessellate_to_file(tessellator, scene, tmp_path / "out.npz", max_memory_bytes=900_000, eps=0.002)
+        tessellate_to_file(tessellator, scene, tmp_path / f"out{suffix}", max_memory_bytes=900_000, eps=0.002)
     assert not any(tmp_path.iterdir())
 
 

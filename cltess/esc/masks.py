@@ -8,7 +8,7 @@ from ..criteria.base import DEFAULT_MAX_FACTOR
 from ..criteria.zheng_sederberg import zs_factors
 from ..kinds.base import FLAG_CULLED, FLAG_SATURATED
 from ..patterns.esc import (BOUNDARY_EDGES, COARSE_EDGES, MAX_LEVEL, PATCH_EDGE_AGAINST, PATCH_EDGE_COARSE,
-                            pack, reverse_bits)
+                            pack, pole_edges, reverse_bits)
 from ..scene import boundary_curves
 from ..surfaces.bezier import evaluate
 
@@ -92,6 +92,14 @@ def patch_masks(patch: np.ndarray, eps: float, level: int, steps: int | None = N
     return masks, tuple(reversed_edges)
 
 
+def pole_bits(curves: np.ndarray) -> np.ndarray:
+    """(P,) bit e set where patch edge e is a pole: its boundary curve's float32 controls (P, 4, 4, 4)
+    are one point, c_k.xyz / c_k.w all equal compared by float32 products (criteria/esc_distance.h)."""
+    curves = np.asarray(curves, np.float32)
+    point = (curves[..., :3] * curves[:, :, :1, 3:] == curves[:, :, :1, :3] * curves[..., 3:]).all(axis=(2, 3))
+    return (point * (1 << np.arange(4))).sum(axis=1).astype(np.int64)
+
+
 def patch_levels(factors: np.ndarray, max_level: int) -> np.ndarray:
     """(P,) each patch's level L_p = patch_steps - 1 from its stage-1 bound factors (P, 4) (the
     Bezier kind's Zheng-Sederberg factors (m, n, m, n); 0 for culled patches)."""
@@ -118,13 +126,13 @@ def esc_stage(patches: np.ndarray, tolerance, max_level: int, max_factor: int = 
     elif any((level + 1) % (int(lp) + 1) for lp in levels):
         raise ValueError(f"patch levels must have L_p + 1 dividing {level + 1}")
     curves = boundary_curves(patches).astype(np.float32)  # (P, 4 edges, 4 controls, 4), as the device sees them
-    # c_k.xyz / c_k.w all equal, compared by float32 products (criteria/esc_distance.h)
-    pole = (curves[..., :3] * curves[:, :, :1, 3:] == curves[:, :, :1, :3] * curves[..., 3:]).all(axis=(2, 3)).any(axis=1)
-    levels = np.where(pole, level, levels)  # a patch at a pole: the full level (docs/esc.md decision 5)
+    poles = pole_bits(curves)
+    levels = np.where(poles > 0, level, levels)  # a patch at a pole: the full level (docs/esc.md decision 5)
     records = np.zeros((len(patches), 4), np.int32)
     for p, patch in enumerate(patches):
         if not culled[p]:
             masks, flips = patch_masks(patch, float(eps[p]), level, int(levels[p]) + 1)
+            masks[list(pole_edges(int(poles[p])))] = (1 << level) - 1  # the pole rule (docs/esc.md)
             records[p] = pack(level, masks, flips)
     flags = np.where(culled, FLAG_CULLED, np.where(saturated | (bound > 3 * (level + 1)), FLAG_SATURATED, 0))
     return records, flags.astype(np.int32)

@@ -73,15 +73,18 @@ inline int4 esc_factors(__global float4 *source, __global float4 *controls, uint
     float eps = bezier_tolerance(b, tol, &culled);
     int level = clamp(max_level, 0, ESC_MAX_LEVEL), n = level + 1, m = 3 * n;  /* levels above 3: capped */
     int factor = max(bound.s0, bound.s1), steps = esc_patch_steps(factor, n);
-    for (int e = 0; e < 4; ++e) {  /* a pole (a boundary curve that is one point): the full level */
+    int poles = 0;  /* bit e: patch edge e is a pole (a boundary curve that is one point) */
+    for (int e = 0; e < 4; ++e) {
         float4 c[4];
         edge_controls(b, e, c);
         int point = 1;  /* c_k.xyz / c_k.w all equal, compared by (correctly rounded) products */
         for (int k = 1; k < 4; ++k)
             point &= all(c[k].xyz * c[0].w == c[0].xyz * c[k].w);
-        if (point)
-            steps = n;
+        poles |= point << e;
     }
+    if (poles)
+        steps = n;  /* a patch at a pole: the full level */
+    uint full = (1u << level) - 1u;  /* the pole rule: a coarse edge into a pole takes every candidate */
 #ifdef ESC_ONE_LEVEL
     steps = n;  /* one level per run, every patch at L (esc.py ESC_ONE_LEVEL: bench/esc.py's baseline) */
 #endif
@@ -105,7 +108,10 @@ inline int4 esc_factors(__global float4 *source, __global float4 *controls, uint
                 float4 h = boundary_point(canonical, t);
                 candidate[k - 1] = h.xyz / h.w;
             }
-            bits |= esc_chord_bits(h0.xyz / h0.w, h1.xyz / h1.w, candidate, level, steps, eps) << (s * level);
+            uint segment = esc_chord_bits(h0.xyz / h0.w, h1.xyz / h1.w, candidate, level, steps, eps);
+            if (poles && esc_pole_edge(esc_boundary_coarse(e, reversed ? 2 - s : s), poles))
+                segment = full;
+            bits |= segment << (s * level);
         }
         slots[e] = (int)bits | (reversed ? ESC_REVERSED : 0);
     }
@@ -120,16 +126,7 @@ inline int4 esc_factors(__global float4 *source, __global float4 *controls, uint
         if (boundary)
             continue;
         int2 start, end;
-        if (c < 12) {
-            start = (int2)(c % 3, c / 3);
-            end = start + (int2)(1, 0);
-        } else if (c < 24) {
-            start = (int2)((c - 12) / 3, (c - 12) % 3);
-            end = start + (int2)(0, 1);
-        } else {
-            start = (int2)((c - 24) % 3, (c - 24) / 3);
-            end = start + (int2)(1, 1);
-        }
+        esc_coarse_ends(c, &start, &end);
         float3 p0 = nbm_position(nbm, (float)start.x / 3.0f, (float)start.y / 3.0f);
         float3 p1 = nbm_position(nbm, (float)end.x / 3.0f, (float)end.y / 3.0f);
         float3 candidate[ESC_MAX_LEVEL];
@@ -137,7 +134,8 @@ inline int4 esc_factors(__global float4 *source, __global float4 *controls, uint
             int2 x = n * start + k * (end - start);
             candidate[k - 1] = nbm_position(nbm, (float)x.x / (float)m, (float)x.y / (float)m);
         }
-        interior |= (ulong)esc_chord_bits(p0, p1, candidate, level, steps, eps) << (slot * level);
+        uint bits = poles && esc_pole_edge(c, poles) ? full : esc_chord_bits(p0, p1, candidate, level, steps, eps);
+        interior |= (ulong)bits << (slot * level);
         ++slot;
     }
     int4 f;

@@ -8,6 +8,7 @@
 #ifndef CLTESS_PATTERNS_ESC_H
 #define CLTESS_PATTERNS_ESC_H
 #include "common.h"
+#include "patterns/esc_counts.h"  /* generated: cltess/patterns/esc.py count_table_header */
 
 #define PATTERN_EDGES 4
 #define PATTERN_EDGE_POINTS(f, e) esc_ring_count(f, e)  /* the record is masks, not counts (patterns/layout.h) */
@@ -25,6 +26,45 @@
 #define ESC_H(i, j) (3 * (j) + (i))
 #define ESC_V(i, j) (12 + 3 * (i) + (j))
 #define ESC_D(i, j) (24 + 3 * (j) + (i))
+
+/* Coarse edge c's end corners (I, J) in its canonical direction (esc.py COARSE_EDGES). */
+inline void esc_coarse_ends(int c, __private int2 *start, __private int2 *end)
+{
+    if (c < 12) {
+        *start = (int2)(c % 3, c / 3);
+        *end = *start + (int2)(1, 0);
+    } else if (c < 24) {
+        *start = (int2)((c - 12) / 3, (c - 12) % 3);
+        *end = *start + (int2)(0, 1);
+    } else {
+        *start = (int2)((c - 24) % 3, (c - 24) / 3);
+        *end = *start + (int2)(1, 1);
+    }
+}
+
+/* Coarse edge number of segment s (counter-clockwise) of patch edge e (esc.py PATCH_EDGE_COARSE). */
+inline int esc_boundary_coarse(int e, int s) { return e == 0 ? s : e == 1 ? 21 + s : e == 2 ? 11 - s : 14 - s; }
+
+/* Is corner p on a pole, a patch edge of bit e in `poles`? */
+inline int esc_on_pole(int2 p, int poles, int e)
+{
+    return (poles >> e) & 1 && (e == 0 ? p.y == 0 : e == 1 ? p.x == 3 : e == 2 ? p.y == 3 : p.x == 0);
+}
+
+/* The pole rule (esc.py pole_edges; docs/esc.md): does coarse edge c run into a pole (an end on
+ * it, not lying on it)?  Stage 1 inserts all its candidates. */
+inline int esc_pole_edge(int c, int poles)
+{
+    int2 start, end;
+    esc_coarse_ends(c, &start, &end);
+    int touches = 0, lies = 0;
+    for (int e = 0; e < 4; ++e) {
+        int a = esc_on_pole(start, poles, e), b = esc_on_pole(end, poles, e);
+        touches |= a | b;
+        lies |= a & b;
+    }
+    return touches && !lies;
+}
 
 inline uint esc_reverse_bits(uint mask, int count)
 {
@@ -233,10 +273,9 @@ inline uint esc_index(__private const esc_patch *g, int2 p)
 /* Coarse triangle t (0..17: cell (i, j) = (t/2 % 3, t/6), lower then upper): apex, B0, B1 in
  * coarse units and its left (A->B0), right (A->B1) and base (B0->B1) masks, counter-clockwise
  * order (esc.py COARSE_TRIANGLES). */
-inline void esc_coarse(__private const esc_patch *g, int t, __private int2 corner[3], __private uint bits[3])
+inline void esc_coarse(__private const esc_record *r, int t, __private int2 corner[3], __private uint bits[3])
 {
-    int cell = t / 2, i = cell % 3, j = cell / 3, level = g->r.level;
-    __private const esc_record *r = &g->r;
+    int cell = t / 2, i = cell % 3, j = cell / 3, level = r->level;
     if ((t & 1) == 0) {
         corner[0] = (int2)(i + 1, j);
         corner[1] = (int2)(i + 1, j + 1);
@@ -365,7 +404,7 @@ inline void esc_coarse_triangle(__private const esc_patch *g, int t, __private e
 {
     int2 corner[3], upper[ESC_MAX_LEVEL + 3], lower[ESC_MAX_LEVEL + 3];  /* chains, right to left */
     uint bits[3];
-    esc_coarse(g, t, corner, bits);
+    esc_coarse(&g->r, t, corner, bits);
     int n = g->r.n, a = 0, upper_length = 1;
     upper[0] = (int2)(0, 0);
     for (int b = 1; b <= n; ++b) {
@@ -440,9 +479,83 @@ inline void esc_walk(int4 f, int collapsed, __private esc_writer *w)
         esc_coarse_triangle(&g, t, w);
 }
 
-/* Triangles ("count" mode when out == 0, "emit" otherwise). */
+/* Stage 3's counts from the masks alone (esc.py counts): each coarse triangle's row of the
+ * generated table (its triangles and strip indices as esc_coarse_triangle walks them; checked
+ * exhaustively against the walk, tests/test_esc_counts.py), less, for a side on a collapsed edge,
+ * its popcount + 1 segments (each one triangle's side; those have two points in one and are left
+ * out).  Two adjacent collapsed edges (their shared corner is one edge's point only): 0, the
+ * caller walks. */
+inline int esc_table_counts(int4 f, int collapsed, __private uint *triangles, __private uint *strip_indices)
+{
+    *triangles = *strip_indices = 0;
+#ifdef ESC_WALK
+    return 0;  /* patterns/esc_walk.h: the baseline of bench/esc.py --stages */
+#endif
+    if (f.s0 <= 0)
+        return 1;
+    if (collapsed & ((collapsed << 1) | (collapsed >> 3)) & 15)
+        return 0;
+    esc_record r = esc_read(f);
+    int level = r.level;
+    __constant const uchar *tris = ESC_TABLE_TRIANGLES + ESC_TABLE_START[level];
+    __constant const uchar *strips = ESC_TABLE_STRIP_INDICES + ESC_TABLE_START[level];
+    for (int t = 0; t < 18; ++t) {
+        int2 corner[3];
+        uint bits[3];
+        esc_coarse(&r, t, corner, bits);
+        uint row = bits[0] | bits[1] << level | bits[2] << (2 * level);
+        *triangles += tris[row];
+        *strip_indices += strips[row];
+        for (int side = 0; collapsed && side < 2; ++side) {
+            int on = 0;
+            for (int e = 0; e < 4; ++e)
+                on |= esc_on_pole(corner[0], collapsed, e) && esc_on_pole(corner[1 + side], collapsed, e);
+            if (on)
+                *triangles -= popcount(bits[side]) + 1;
+        }
+    }
+    return 1;
+}
+
+/* Stage 5's triangle list from the table (esc.py triangle_table: coarse_triangle's triangles in
+ * order) through the patch's vertex numbering, a triangle with two points in one (a side on a
+ * collapsed edge) left out as the walk does; counted only when out == 0. */
+inline uint esc_table_triangles(int4 f, int collapsed, __global uint *out, uint base)
+{
+    if (f.s0 <= 0)
+        return 0;
+    esc_patch g;
+    esc_setup(f, collapsed, &g);
+    int level = g.r.level, n = g.r.n;
+    uint count = 0;
+    for (int t = 0; t < 18; ++t) {
+        int2 corner[3];
+        uint bits[3];
+        esc_coarse(&g.r, t, corner, bits);
+        int row = ESC_TABLE_START[level] + (int)(bits[0] | bits[1] << level | bits[2] << (2 * level));
+        __constant const uchar *points = ESC_TABLE_TRIANGLE_POINTS + ESC_TABLE_TRIANGLE_FIRST[row];
+        for (int k = 0, end = 3 * ESC_TABLE_TRIANGLES[row]; k < end; k += 3) {
+            uint index[3];
+            for (int c = 0; c < 3; ++c)
+                index[c] = esc_index(&g, esc_lattice(corner, n, (int2)(points[k + c] / ESC_STRIP_POINT_BASE,
+                                                                          points[k + c] % ESC_STRIP_POINT_BASE)));
+            if (index[0] != index[1] && index[1] != index[2] && index[0] != index[2])
+                put_triangle(out, &count, base, index[0], index[1], index[2]);
+        }
+    }
+    return count;
+}
+
+/* Triangles ("count" mode when out == 0: the table's sums, or, with two adjacent collapsed
+ * edges, the table's triangles through the numbering; "emit" otherwise). */
 inline uint pattern_primitives(int4 f, int collapsed, __global uint *out, uint base)
 {
+    uint triangles, strip_indices;
+    if (!out && esc_table_counts(f, collapsed, &triangles, &strip_indices))
+        return triangles;
+#ifndef ESC_WALK
+    return esc_table_triangles(f, collapsed, out, base);
+#endif
     esc_writer w;
     w.triangles = out;
     w.strips = 0;
@@ -453,11 +566,45 @@ inline uint pattern_primitives(int4 f, int collapsed, __global uint *out, uint b
     return w.triangle_count;
 }
 
+/* Stage 5's strips from the table (esc.py strip_table: coarse_triangle's strips, each band's
+ * points in order, rule-4 copies included) through the patch's vertex numbering: the walk's
+ * strips without zipping the bands again (tests: equal to the walk and the mirror). */
+inline uint esc_table_strips(int4 f, int collapsed, __global uint *out, uint base)
+{
+    if (f.s0 <= 0)
+        return 0;
+    esc_patch g;
+    esc_setup(f, collapsed, &g);
+    int level = g.r.level, n = g.r.n;
+    uint at = 0;
+    for (int t = 0; t < 18; ++t) {
+        int2 corner[3];
+        uint bits[3];
+        esc_coarse(&g.r, t, corner, bits);
+        int row = ESC_TABLE_START[level] + (int)(bits[0] | bits[1] << level | bits[2] << (2 * level));
+        __constant const uchar *points = ESC_TABLE_STRIP_POINTS + ESC_TABLE_STRIP_FIRST[row];
+        int count = ESC_TABLE_STRIP_INDICES[row];
+        for (int k = 0; out && k < count; ++k) {
+            int code = points[k];
+            out[at + k] = code == ESC_STRIP_TABLE_RESTART ? STRIP_RESTART
+                : base + esc_index(&g, esc_lattice(corner, n, (int2)(code / ESC_STRIP_POINT_BASE, code % ESC_STRIP_POINT_BASE)));
+        }
+        at += count;
+    }
+    return at;
+}
+
 /* Strip indices, each strip followed by STRIP_RESTART (count mode when out == 0): one strip per
  * band of a coarse triangle, esc.py patch_mesh's strips in its order (stages/strip_counts.cl,
  * strip_indices.cl; cltess/backends/opencl/strips.py). */
 inline uint pattern_strips(int4 f, int collapsed, __global uint *out, uint base)
 {
+    uint triangles, strip_indices;
+    if (!out && esc_table_counts(f, collapsed, &triangles, &strip_indices))
+        return strip_indices;
+#ifndef ESC_WALK
+    return esc_table_strips(f, collapsed, out, base);  /* out == 0 here: adjacent collapsed edges, counted */
+#endif
     esc_writer w;
     w.triangles = 0;
     w.strips = out;
