@@ -8,7 +8,9 @@
 #ifndef CLTESS_PATTERNS_ESC_H
 #define CLTESS_PATTERNS_ESC_H
 #include "common.h"
-#include "patterns/esc_counts.h"  /* generated: cltess/patterns/esc.py count_table_header */
+/* generated: cltess/patterns/esc.py count_table_header (no comment on an #include line: pyopencl's
+ * binary cache looks for the headers a program depends on only in plain #include lines) */
+#include "patterns/esc_counts.h"
 
 #define PATTERN_EDGES 4
 #define PATTERN_EDGE_POINTS(f, e) esc_ring_count(f, e)  /* the record is masks, not counts (patterns/layout.h) */

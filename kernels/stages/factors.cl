@@ -9,7 +9,8 @@
  * the patches in controls.  source is writable for a kind that keeps per-patch constants there
  * (PatchKind.per_patch_constants: the Bezier kind's bound). */
 #ifdef PATTERN_ESC
-#include "criteria/esc_distance.h"  /* the pattern's own stage 1: candidate masks (patterns/esc.h) */
+/* the pattern's own stage 1: candidate masks (patterns/esc.h) */
+#include "criteria/esc_distance.h"
 #endif
 
 __kernel void factors(__global float4 *source, __global float4 *controls, uint num_patches,
