@@ -53,16 +53,33 @@ def test_fused_offsets_above_the_cap_use_the_scans(fused, monkeypatch, rng):
 
 
 def test_a_pattern_that_counts_by_walking_uses_the_scans(fused, rng):
-    """ESC's counts walk its bands (Pattern.counts_walk): one work-group would run that walk for
-    every patch on one compute unit, so stage 3 keeps the counts kernel and the scan; a pattern
-    with closed-form counts in the same call takes the one launch."""
+    """A pattern whose counts walk it (Pattern.counts_walk: ESC before its tables, esc.ESC_WALK):
+    one work-group would run that walk for every patch on one compute unit, so stage 3 keeps the
+    counts kernel and the scan; a pattern with closed-form or table counts takes the one launch."""
     from cltess.patterns import PATTERNS
+    from cltess.patterns.esc import ESC_WALK
+    from support.factors import random_esc_records
 
-    factors = cl_array.to_device(fused.queue, random_factors(rng, 50))
-    assert PATTERNS["esc"].counts_walk and not PATTERNS["quad_transition"].counts_walk
-    _, _, walked = fused.stage_counts(factors, kind=PATTERNS["esc"])
-    _, _, closed = fused.stage_counts(factors, kind=PATTERNS["quad_transition"])
-    assert len(walked) == 2 and len(closed) == 1  # counts kernel + pair scan; one launch
+    records = cl_array.to_device(fused.queue, random_esc_records(rng, 50))
+    assert ESC_WALK.counts_walk and not PATTERNS["esc"].counts_walk
+    _, _, walked = fused.stage_counts(records, kind=ESC_WALK)
+    _, _, tabled = fused.stage_counts(records, kind=PATTERNS["esc"])
+    assert len(walked) == 2 and len(tabled) == 1  # counts kernel + pair scan; one launch
+
+
+def test_esc_offsets_in_one_launch_are_the_scans(tessellator, fused, rng):
+    """ESC's counts from its tables (patterns/esc_counts.h) in stages/offsets.cl: the offsets of
+    the counts kernel and the scan, over several tiles."""
+    from cltess.patterns import PATTERNS
+    from support.factors import random_esc_records
+
+    records = random_esc_records(rng, 3000)
+    scans = opencl.Tessellator(tessellator.device, work="patch")
+    scans.fused_offsets = False
+    got = [[a.get() for a in tess.stage_counts(cl_array.to_device(tess.queue, records), kind=PATTERNS["esc"])[:2]]
+           for tess in (scans, fused)]
+    assert np.array_equal(got[0][0], got[1][0]) and np.array_equal(got[0][1], got[1][1])
+    assert got[1][1][-1] > 0
 
 
 def test_fused_offsets_setting(tessellator, monkeypatch):

@@ -34,10 +34,11 @@ class Pattern:
                ESC: esc.strip_indices); the NumPy backend's Tessellation.strips.
     layout:    the NumPy mirror, f -> (uv (V, 2) float64, triangles (T, 3) int64 local indices):
                the ring first, then the interior rows, as the device lays the vertices out.
-    counts_walk: its counts walk the whole pattern (ESC: every band of the 18 coarse triangles)
-               rather than a closed form: stage 3 then keeps a work-item per patch over the whole
-               device, never the one-work-group launch of stages/offsets.cl (on the H100 that
-               made Teacups' stage 3 3.05 ms against 0.76).
+    counts_walk: its counts walk the whole pattern rather than a closed form or a table (ESC
+               before its tables, esc.ESC_WALK: every band of the 18 coarse triangles): stage 3
+               then keeps a work-item per patch over the whole device, never the
+               one-work-group launch of stages/offsets.cl (on the H100 that made Teacups' stage 3
+               3.05 ms against 0.76).
     """
 
     name: str

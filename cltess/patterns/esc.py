@@ -491,13 +491,13 @@ def _stage1_one_level(patches, tolerance, max_level, max_factor):
 
 
 ESC = Pattern("esc", "quad", 4, "patterns/esc.h", layout, crack="crack/or_masks.h", primitive="strips",
-              stage1=((("PATTERN_ESC", 1),), _stage1), strips=strip_indices, counts_walk=True)
+              stage1=((("PATTERN_ESC", 1),), _stage1), strips=strip_indices)
 
 #: ESC with one level per run (every patch at L = max level, as before per-patch levels): not in
 #: the registry; bench/esc.py adds it to PATTERNS to measure what per-patch levels change.
 ESC_ONE_LEVEL = Pattern("esc_one_level", "quad", 4, "patterns/esc.h", layout, crack="crack/or_masks.h",
                         primitive="strips", stage1=((("PATTERN_ESC", 1), ("ESC_ONE_LEVEL", 1)), _stage1_one_level),
-                        strips=strip_indices, counts_walk=True)
+                        strips=strip_indices)
 
 #: ESC as before the tables (kernels/patterns/esc_walk.h): stage 3's counts and stage 5's triangles
 #: and strips walked band by band; not in the registry: bench/esc.py --stages adds it to PATTERNS.
