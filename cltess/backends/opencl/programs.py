@@ -60,6 +60,33 @@ WORK_STAGES = {"rows": ("vertex_rows",), "vertex": ("vertex_points",), "point": 
                "vertex-prep": ("prepared_points",), "point-prep": ("prepared_points", "triangles")}
 
 
+class Kernel:
+    """A built kernel whose scalar arguments' C types are fixed at its first launch, from the
+    NumPy scalars it was given (``pyopencl.Kernel.set_arg_types``): later launches pack each
+    scalar with ``struct`` (0.3 us) instead of pyopencl's generic ``set_arg`` of a NumPy
+    scalar (9 us each on Intel's CPU runtime and PoCL, bench/RESULTS.md "Issue 15: a frame's
+    host cost"; a frame sets about 20).  Buffers, ``LocalMemory`` and anything but a NumPy
+    scalar keep the generic path.  Every call site passes a kernel parameter the same NumPy
+    type each time (the kernel's C type); a later value of another type is packed as the first
+    call's type, or refused by ``struct`` (out of range, wrong kind), never reinterpreted.
+    Anything else (``get_work_group_info``, ``function_name``) is the pyopencl kernel's."""
+
+    __slots__ = ("kernel", "arg_types")
+
+    def __init__(self, kernel: cl.Kernel):
+        self.kernel = kernel
+        self.arg_types = None
+
+    def __call__(self, queue, global_size, local_size, *args, **options) -> cl.Event:
+        if self.arg_types is None:
+            self.arg_types = tuple(a.dtype if isinstance(a, np.generic) else None for a in args)
+            self.kernel.set_arg_types(self.arg_types)
+        return self.kernel(queue, global_size, local_size, *args, **options)
+
+    def __getattr__(self, name):
+        return getattr(self.kernel, name)
+
+
 def kernel_dir() -> Path:
     """Folder of the kernel sources (top-level kernels/, installed as cltess.kernels)."""
     return Path(str(resources.files("cltess.kernels")))
@@ -127,7 +154,7 @@ class Programs:
             neutral="offset_pair_of(0, 0)",
             output_statement="vertex_offsets[i + 1] = item.v; index_offsets[i + 1] = item.i;")
 
-    def kernel(self, stage: str, entry: str | None = None, **axes) -> cl.Kernel:
+    def kernel(self, stage: str, entry: str | None = None, **axes) -> Kernel:
         """The stage's kernel composed for ``axes`` (kind=, pattern=, tolerance=, crack=): the
         one named as the stage, or ``entry`` where its file holds several."""
         headers, defines = composition(stage, **axes)
@@ -135,7 +162,7 @@ class Programs:
         if key not in self._programs:
             self._programs[key] = self.build(stage, headers, defines)
         if (key, entry) not in self._kernels:  # one Kernel object each: pyopencl caches its call set-up
-            self._kernels[key, entry] = getattr(self._programs[key], entry or stage)
+            self._kernels[key, entry] = Kernel(getattr(self._programs[key], entry or stage))
         return self._kernels[key, entry]
 
     def compose(self, kind, pattern, tolerance, work: str = "patch") -> None:
