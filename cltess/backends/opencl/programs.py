@@ -137,6 +137,7 @@ class Programs:
         self.context = context
         self._programs: dict = {}
         self._kernels: dict = {}
+        self._seen: dict = {}  # Programs.kernel's look-up by the identity of its arguments
         self.offsets_scan = GenericScanKernel(
             context, np.uint64, arguments="__global const ulong *counts, __global ulong *offsets",
             input_expr="counts[i]", scan_expr="a+b", neutral="0",
@@ -154,9 +155,21 @@ class Programs:
             neutral="offset_pair_of(0, 0)",
             output_statement="vertex_offsets[i + 1] = item.v; index_offsets[i + 1] = item.i;")
 
-    def kernel(self, stage: str, entry: str | None = None, **axes) -> Kernel:
-        """The stage's kernel composed for ``axes`` (kind=, pattern=, tolerance=, crack=): the
-        one named as the stage, or ``entry`` where its file holds several."""
+    def kernel(self, stage: str, entry: str | None = None, kind=None, pattern=None, tolerance=None,
+               crack: str = "crack/max.h") -> Kernel:
+        """The stage's kernel composed for kind=, pattern=, tolerance=, crack=: the one named as
+        the stage, or ``entry`` where its file holds several.  Found again by the identity of
+        the kind and pattern (registry objects, kept alive by the entry) and the tolerance's
+        class (its defines are the class's): a frame looks up each of its kernels this way."""
+        seen = (stage, entry, id(kind), id(pattern), type(tolerance), crack)
+        found = self._seen.get(seen)
+        if found is not None:
+            return found[0]
+        found = self._kernel(stage, entry, kind=kind, pattern=pattern, tolerance=tolerance, crack=crack)
+        self._seen[seen] = (found, kind, pattern)
+        return found
+
+    def _kernel(self, stage: str, entry: str | None, **axes) -> Kernel:
         headers, defines = composition(stage, **axes)
         key = (stage, headers, tuple(sorted(defines.items())))
         if key not in self._programs:

@@ -167,7 +167,10 @@ def wait_ms(events) -> float:
 
 def _span_ms(events) -> float:
     """Device milliseconds from the first event's start to the last one's end."""
-    return (events[-1].profile.end - events[0].profile.start) * 1e-6
+    return (events[-1].get_profiling_info(_END) - events[0].get_profiling_info(_START)) * 1e-6
+
+
+_START, _END = cl.profiling_info.START, cl.profiling_info.END
 
 
 class Tessellator:
