@@ -72,11 +72,15 @@ class Session:
                 raise ValueError("camera= is for a pixel tolerance; this session's is eps "
                                  f"{tolerance.eps!r} (give pixels= to the session or to this call)")
             tolerance = ScreenSpace(tolerance.pixels, camera)
+        if camera is not None and not overrides and tolerance.pixels == getattr(request.tolerance, "pixels", None):
+            # A new camera alone: the request as it was, with this tolerance (its fields were
+            # checked when it was made; check() asks for a camera, which there now is).
+            framed = object.__new__(Request)
+            framed.__dict__.update(request.__dict__, tolerance=tolerance)
+            return framed
         if tolerance is not request.tolerance or overrides:
-            changed = overrides or camera is None or not isinstance(request.tolerance, ScreenSpace)
             request = dataclasses.replace(request, tolerance=tolerance, **overrides)
-            if changed:  # a new camera alone changes nothing that check looks at
-                request.check(self.scene)
+            request.check(self.scene)
         return request
 
     def tessellate(self, camera: Camera | None = None, wait: bool = True, **request_overrides) -> Tessellation:
