@@ -50,6 +50,7 @@ for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):  # 
 
 import argparse  # noqa: E402
 import hashlib  # noqa: E402
+import inspect  # noqa: E402
 import json  # noqa: E402
 import math  # noqa: E402
 import statistics  # noqa: E402
@@ -188,55 +189,71 @@ def overlapped(session, cameras, rounds: int = 3) -> dict:
     """Frames that overlap (``Session.tessellate(wait=False)``): each call returns once stages
     4-5 are enqueued, so the host's next frame (camera, stages 1-3 enqueued) runs while they
     do.  Wall per frame = the loop's wall clock / frames, the last frame waited for; the best
-    of ``rounds`` loops over the cameras."""
-    best, device = math.inf, []
+    of ``rounds`` loops over the cameras, alternating with the same loop of frames that wait
+    (``wait=True``: "looped"), timed the same way."""
+    best = {True: math.inf, False: math.inf}
+    device = []
     for _ in range(rounds):
-        started = time.perf_counter()
-        kept = []
-        for camera in cameras:
-            kept.append(session.tessellate(camera=camera, wait=False))
-        kept[-1].finish()
-        best = min(best, (time.perf_counter() - started) * 1e3 / len(cameras))
-        device += [device_ms(frame) for frame in kept]  # (their stages are done: in-order queue)
-    return {"overlapped_wall_ms": best, "overlapped_device_ms": statistics.median(device)}
+        for wait in (True, False):
+            started = time.perf_counter()
+            kept = []
+            for camera in cameras:
+                kept.append(session.tessellate(camera=camera, wait=wait))
+            kept[-1].finish()
+            best[wait] = min(best[wait], (time.perf_counter() - started) * 1e3 / len(cameras))
+            device += [device_ms(frame) for frame in kept]  # (their stages are done: in-order queue)
+    return {"looped_wall_ms": best[True], "overlapped_wall_ms": best[False],
+            "overlapped_device_ms": statistics.median(device)}
 
 
 def host_parts(session, cameras, rounds: int = 3) -> dict:
     """A frame's host time split into its steps (``Session.tessellate``'s, one by one), median
     µs over the frames: the request for the camera, program look-up (skipped for a new camera
-    alone), stages 1-3 enqueued, the wait for their totals, stages 4-5 enqueued, the wait for
-    them and the result, and the read-back to host arrays (and its wait)."""
+    alone where the tree does), stages 1-3 enqueued, the wait for their totals, stages 4-5
+    enqueued, the wait for them and the result, and the read-back to host arrays (and its
+    wait).  The waits are timed by wrapping ``pyopencl.wait_for_events``, through which every
+    tree waits, so that the script gives the same split for a tree before this one."""
     tessellator, clock = session.tessellator, time.perf_counter_ns
     parts = {name: [] for name in ("request", "compose", "stages 1-3 (host)", "totals wait", "stages 4-5 (host)",
                                    "stages 4-5 wait + result", "of which wait", "fetch (host arrays)",
                                    "of which read-back wait", "host, total", "wall, total")}
     key = session.request.sharp_edges
-    for _ in range(rounds):
-        for camera in cameras:
-            t0 = clock()
-            request = session.request_for(camera)
-            t1 = clock()
-            if getattr(session, "_composed", None) is None:  # (a tree before the skip: every frame)
-                tessellator.compose(session.scene, request)
-            t2 = clock()
-            plan = tessellator.plan_on(session._scene_data[key], request, None, session._scratch[key])
-            t3 = clock()
-            pending = tessellator.emit_async(plan, 0, plan.num_patches, out=session.output)
-            t4 = clock()
-            frame = pending.result(on_device=True)
-            t5 = clock()
-            waits = frame.wall_ms["waits"]
-            frame.fetch()
-            t6 = clock()
-            read_back_wait = frame.wall_ms["waits"] - waits
-            total_wait = frame.wall_ms["waits"] * 1e3
-            for name, value in (("request", t1 - t0), ("compose", t2 - t1),
-                                ("stages 1-3 (host)", t3 - t2 - plan.wait_ms * 1e6), ("totals wait", plan.wait_ms * 1e6),
-                                ("stages 4-5 (host)", t4 - t3), ("stages 4-5 wait + result", t5 - t4),
-                                ("of which wait", (waits - plan.wait_ms) * 1e6), ("fetch (host arrays)", t6 - t5),
-                                ("of which read-back wait", read_back_wait * 1e6),
-                                ("host, total", t6 - t0 - total_wait * 1e3), ("wall, total", t6 - t0)):
-                parts[name].append(value / 1e3)
+    waits, wait_for_events = [], cl.wait_for_events
+
+    def timed_wait(events):
+        started = clock()
+        wait_for_events(events)
+        waits.append(clock() - started)
+
+    cl.wait_for_events = timed_wait
+    try:
+        for _ in range(rounds):
+            for camera in cameras:
+                waits.clear()
+                t0 = clock()
+                request = session.request_for(camera)
+                t1 = clock()
+                if getattr(session, "_composed", None) is None:  # (a tree before the skip: every frame)
+                    tessellator.compose(session.scene, request)
+                t2 = clock()
+                plan = tessellator.plan_on(session._scene_data[key], request, None, session._scratch[key])
+                t3 = clock()
+                pending = tessellator.emit_async(plan, 0, plan.num_patches, out=session.output)
+                t4 = clock()
+                frame = pending.result(on_device=True)
+                t5 = clock()
+                frame.fetch()
+                t6 = clock()
+                totals, stages45, read_back = (waits + [0, 0, 0])[:3]
+                for name, value in (("request", t1 - t0), ("compose", t2 - t1),
+                                    ("stages 1-3 (host)", t3 - t2 - totals), ("totals wait", totals),
+                                    ("stages 4-5 (host)", t4 - t3), ("stages 4-5 wait + result", t5 - t4),
+                                    ("of which wait", stages45), ("fetch (host arrays)", t6 - t5),
+                                    ("of which read-back wait", read_back),
+                                    ("host, total", t6 - t0 - sum(waits)), ("wall, total", t6 - t0)):
+                    parts[name].append(value / 1e3)
+    finally:
+        cl.wait_for_events = wait_for_events
     return {name: statistics.median(values) for name, values in parts.items()}
 
 
@@ -260,21 +277,29 @@ def frame_loop(tessellator, key: str, count: int) -> dict:
             "resident_wall_ms": median(resident, "stages_wall_ms"), "resident_host_ms": median(resident, "host_ms"),
             "host_wall_ms": median(held, "total_wall_ms"), "host_host_ms": median(held, "host_ms"),
             "host_device_ms": median(held, "device_ms"), "read_back_ms": median(held, "read_back_ms"),
-            **overlapped(session, path), "parts": host_parts(session, path)}
+            **(overlapped(session, path) if OVERLAPS else {}), "parts": host_parts(session, path)}
+
+
+#: Whether this cltess has Session.tessellate(wait=False) (the script also runs on older trees
+#: through PYTHONPATH, for before/after figures).
+OVERLAPS = "wait" in inspect.signature(cltess.Session.tessellate).parameters
 
 
 def frame_report(record: dict) -> list[str]:
     lines = [f"Frame loop, {record['frames']} cameras per scene, {PIXELS} px (median per frame, ms; device: the "
              "stages' profiling spans; host: wall minus the waits for the device; overlapped: "
-             "Session.tessellate(wait=False), the loop's wall / frames):", "",
+             "Session.tessellate(wait=False), the loop's wall / frames, best of 3 loops; looped: the same loop "
+             "with frames that wait):", "",
              "| scene | triangles | device | on device: wall | host | ratio | host arrays: wall | host | ratio | "
-             "overlapped: wall | ratio | setup s |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "looped: wall | overlapped: wall | ratio | setup s |", "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for f in record["frame_loop"]:
         lines.append(f"| {f['scene']} | {f['triangles']:,.0f} | {f['device_ms']:.3f} | {f['resident_wall_ms']:.3f} | "
                      f"{f['resident_host_ms']:.3f} | {f['resident_wall_ms'] / f['device_ms']:.2f}x | "
                      f"{f['host_wall_ms']:.3f} | {f['host_host_ms']:.3f} | "
-                     f"{f['host_wall_ms'] / f['host_device_ms']:.2f}x | {f['overlapped_wall_ms']:.3f} | "
-                     f"{f['overlapped_wall_ms'] / f['overlapped_device_ms']:.2f}x | {f['setup_s']:.1f} |")
+                     f"{f['host_wall_ms'] / f['host_device_ms']:.2f}x | {f.get('looped_wall_ms', math.nan):.3f} | "
+                     f"{f.get('overlapped_wall_ms', math.nan):.3f} | "
+                     f"{f.get('overlapped_wall_ms', math.nan) / f.get('overlapped_device_ms', 1.0):.2f}x | "
+                     f"{f['setup_s']:.1f} |")
     names = list(record["frame_loop"][0]["parts"]) if record["frame_loop"] else []
     lines += ["", "A frame's host time by step (µs, median; Session.tessellate's steps one by one, then fetch):", "",
               "| step | " + " | ".join(f["scene"] for f in record["frame_loop"]) + " |",
