@@ -75,7 +75,7 @@ class Session:
         if camera is not None and not overrides and tolerance.pixels == getattr(request.tolerance, "pixels", None):
             # A new camera alone: the request as it was, with this tolerance (its fields were
             # checked when it was made; check() asks for a camera, which there now is).
-            framed = object.__new__(Request)
+            framed = object.__new__(type(request))
             framed.__dict__.update(request.__dict__, tolerance=tolerance)
             return framed
         if tolerance is not request.tolerance or overrides:
