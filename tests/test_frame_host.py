@@ -142,3 +142,23 @@ def test_frames_that_do_not_wait(tessellator, tea_table):
     with pytest.raises(ValueError, match="on_device"):
         plan = tessellator.plan(tea_table, pixels=0.5)
         tessellator.emit_async(plan, 0, plan.num_patches).result(on_device=False, wait=False)
+
+
+def test_a_cpu_devices_output_is_one_allocation_mapped_once(tessellator, tea_table):
+    """On a CPU device the output fields are sub-buffers of one allocation (one map a fetch);
+    growing re-makes all of them, and every frame still reads back its own output."""
+    session = cltess.Session(tea_table, tessellator=tessellator, eps=0.02)
+    if not session.output.mapped:
+        pytest.skip("a CPU device's buffers")
+    coarse = session.tessellate()
+    parent = session.output._parent
+    align = max(1, tessellator.device.mem_base_addr_align // 8)
+    assert all(buffer.offset % align == 0 and buffer.size >= 1 for buffer, _ in session.output._buffers.values())
+    assert_same(coarse, tessellator.tessellate(tea_table, eps=0.02))
+    fine = session.tessellate(eps=0.002)  # more output: one new allocation for every field
+    assert session.output._parent is not parent and session.output.nbytes > parent.size
+    assert_same(fine, tessellator.tessellate(tea_table, eps=0.002))
+    assert len(session.output._maps) == 1  # the fetch mapped once
+    again = session.tessellate(eps=0.02)  # fewer: the same allocation
+    assert session.output._parent.size == session.output.nbytes
+    assert_same(again, tessellator.tessellate(tea_table, eps=0.02))

