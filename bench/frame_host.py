@@ -13,7 +13,12 @@ frame records
 * "on device": wall ms of ``session.tessellate(camera=...)``, until the stages are done and the
   output is on the device;
 * "host arrays": wall ms of ``session.tessellate(camera=...).fetch()``, until the caller holds
-  host arrays (a mapping on a CPU device, a copy through page-locked memory on a GPU).
+  host arrays (a mapping on a CPU device, a copy through page-locked memory on a GPU);
+* "(host)" after each: that wall minus the ms blocked in ``pyopencl.wait_for_events`` (patched
+  in the child to time it, in both trees): the host's own work per frame;
+* "looped", "overlap" (a tree with ``Session.tessellate(wait=False)``): a loop over the cameras
+  with frames that wait and with frames that overlap, the median interval from one call's return
+  to the next (``frame_loop.overlapped``).
 
 Per scene the report gives, for each tree, the median over frames, then the *smallest* of the
 ``--repeat`` children's medians (the machine is shared: the least disturbed run), and the
@@ -40,7 +45,20 @@ def child(args) -> dict:
 
     warnings.simplefilter("ignore")
     import frame_loop as fl
+    import inspect
+    import pyopencl as cl
     import cltess
+
+    waited = [0]  # ns blocked in pyopencl.wait_for_events (both trees wait through it)
+    wait_for_events = cl.wait_for_events
+
+    def timed_wait(events):
+        started = time.perf_counter_ns()
+        wait_for_events(events)
+        waited[0] += time.perf_counter_ns() - started
+
+    cl.wait_for_events = timed_wait
+    overlaps = "wait" in inspect.signature(cltess.Session.tessellate).parameters
     from cltess.backends.opencl import Tessellator
     from cltess.bench.suite import device_info, resolve_scenes
 
@@ -52,18 +70,26 @@ def child(args) -> dict:
         path = list(fl.orbit(scene.camera, args.frames))
         for camera in path:  # warm-up: builds, uploads, buffers at their size
             session.tessellate(camera=camera).fetch()
-        resident, held, device = [], [], []
+        resident, held, device, resident_host, held_host = [], [], [], [], []
         for camera in path:
+            waited[0] = 0
             started = time.perf_counter()
             frame = session.tessellate(camera=camera)
             resident.append((time.perf_counter() - started) * 1e3)
+            resident_host.append(resident[-1] - waited[0] / 1e6)
             device.append(fl.device_ms(frame))
         for camera in path:
+            waited[0] = 0
             started = time.perf_counter()
             session.tessellate(camera=camera).fetch()
             held.append((time.perf_counter() - started) * 1e3)
-        rows.append({"scene": key, "triangles": frame.num_triangles, "device_ms": statistics.median(device),
-                     "resident_ms": statistics.median(resident), "host_ms": statistics.median(held)})
+            held_host.append(held[-1] - waited[0] / 1e6)
+        row = {"scene": key, "triangles": frame.num_triangles, "device_ms": statistics.median(device),
+               "resident_ms": statistics.median(resident), "host_ms": statistics.median(held),
+               "resident_host_ms": statistics.median(resident_host), "held_host_ms": statistics.median(held_host)}
+        if overlaps:
+            row.update(fl.overlapped(session, path))
+        rows.append(row)
     record = {"device": device_info(tessellator.device), "rows": rows, "cltess": cltess.__file__}
     if args.grid:
         sizes = [(1, 13), (10, 13), (100, 13), (1000, 13)]
@@ -112,7 +138,8 @@ def main() -> int:
           f"{args.frames} frames, best of {args.repeat} children per tree (median per frame, ms)")
     header = f"{'scene':20} {'triangles':>10}"
     for name in trees:
-        header += f" | {name + ' device':>14} {'on device':>10} {'ratio':>6} {'host arr.':>10} {'ratio':>6}"
+        header += (f" | {name + ' device':>14} {'on device':>10} {'(host)':>7} {'ratio':>6} {'host arr.':>10} {'(host)':>7}"
+                   f" {'ratio':>6} {'looped':>8} {'overlap':>8} {'ratio':>6}")
     print(header)
     result = {"device": device, "load": [load_before, os.getloadavg()], "command": " ".join(sys.argv), "scenes": []}
     for index, row in enumerate(runs["this"][0]["rows"]):
@@ -120,8 +147,14 @@ def main() -> int:
         entry = {"scene": row["scene"], "triangles": row["triangles"]}
         for name in trees:
             best = min((run["rows"][index] for run in runs[name]), key=lambda r: r["host_ms"])
-            line += (f" | {best['device_ms']:>14.3f} {best['resident_ms']:>10.3f} {best['resident_ms'] / best['device_ms']:>5.2f}x"
-                     f" {best['host_ms']:>10.3f} {best['host_ms'] / best['device_ms']:>5.2f}x")
+            line += (f" | {best['device_ms']:>14.3f} {best['resident_ms']:>10.3f} {best['resident_host_ms']:>7.3f}"
+                     f" {best['resident_ms'] / best['device_ms']:>5.2f}x"
+                     f" {best['host_ms']:>10.3f} {best['held_host_ms']:>7.3f} {best['host_ms'] / best['device_ms']:>5.2f}x")
+            if "overlapped_wall_ms" in best:
+                line += (f" {best['looped_wall_ms']:>8.3f} {best['overlapped_wall_ms']:>8.3f}"
+                         f" {best['overlapped_wall_ms'] / best['overlapped_device_ms']:>5.2f}x")
+            else:
+                line += f" {'-':>8} {'-':>8} {'-':>6}"
             entry[name] = best
         print(line)
         result["scenes"].append(entry)

@@ -27,7 +27,12 @@ On one OpenCL device, in this order, every figure a median (or the best, where s
    the device time (sum of the stages' profiling spans), the host wall time until the stages
    are done and the output is on the device ("device-resident"), and until the caller holds
    host arrays ("host arrays": mapped on a CPU device, copied through page-locked memory on a
-   GPU).  The first frame (kernel builds, uploads) is left out.
+   GPU); of each wall, the host time (wall minus the ms blocked waiting for the device,
+   ``wall_ms["waits"]``); frames that overlap (``Session.tessellate(wait=False)``: the loop's
+   wall clock / frames); and a frame's host time by step (``host_parts``).  The first pass
+   over the cameras (kernel builds, uploads, buffers grown) is left out.
+   ``--frames-only`` runs sections 3 and 4 and nothing else (``--grid-copies`` picks section
+   4's sizes; none: no grid).
 4. **Against a one-thread NumPy grid**, from 10k triangles up: P teapot patches at uniform
    factor f; NumPy evaluates the same f x f grid per patch (float32, einsum over Bernstein
    bases, positions, normals, uv, ids and triangles: the same output record) on one thread;
@@ -45,6 +50,7 @@ for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):  # 
 
 import argparse  # noqa: E402
 import hashlib  # noqa: E402
+import inspect  # noqa: E402
 import json  # noqa: E402
 import math  # noqa: E402
 import statistics  # noqa: E402
@@ -163,17 +169,102 @@ def orbit(camera: Camera, count: int):
 
 def frames(session, cameras, host: bool, **overrides) -> list[dict]:
     """Per frame: device ms, wall ms until the output is on the device, and (host) until the
-    caller holds host arrays."""
+    caller holds host arrays; of the wall, the ms blocked in waits for the device (the rest is
+    host work: Python, launches, copies' set-up)."""
     out = []
     for camera in cameras:
         frame = session.tessellate(camera=camera, **overrides)
         if host:
             frame.fetch()
+        total = frame.wall_ms.get("total", frame.wall_ms["stages"])
+        waits = frame.wall_ms.get("waits", math.nan)  # (a tree before wall_ms["waits"]: NaN)
         out.append({"device_ms": device_ms(frame), "stages_wall_ms": frame.wall_ms["stages"],
-                    "total_wall_ms": frame.wall_ms.get("total", frame.wall_ms["stages"]),
+                    "total_wall_ms": total, "waits_ms": waits, "host_ms": total - waits,
                     "read_back_ms": frame.wall_ms.get("read_back", 0.0), "triangles": frame.num_triangles,
                     "bytes": output_bytes(frame)})
     return out
+
+
+def overlapped(session, cameras, rounds: int = 3) -> dict:
+    """Frames that overlap (``Session.tessellate(wait=False)``): each call returns once stages
+    4-5 are enqueued, so the host's next frame (camera, stages 1-3 enqueued) runs while they
+    do.  Wall per frame: the median over ``rounds`` loops of the interval from one call's
+    return to the next one's (the steady state's period; a median, so that a preemption of
+    this process on a shared machine counts as it does in the per-call figures), alternating
+    with the same loop of frames that wait (``wait=True``: "looped"); and the loops' mean
+    (wall clock / frames, the last frame waited for)."""
+    intervals = {True: [], False: []}
+    means = {True: [], False: []}
+    device = []
+    clock = time.perf_counter
+    for _ in range(rounds):
+        for wait in (True, False):
+            kept = []
+            started = last = clock()
+            for camera in cameras:
+                kept.append(session.tessellate(camera=camera, wait=wait))
+                now = clock()
+                intervals[wait].append(now - last)
+                last = now
+            kept[-1].finish()
+            means[wait].append((clock() - started) / len(cameras))
+            device += [device_ms(frame) for frame in kept]  # (their stages are done: in-order queue)
+    return {"looped_wall_ms": statistics.median(intervals[True]) * 1e3,
+            "overlapped_wall_ms": statistics.median(intervals[False]) * 1e3,
+            "looped_mean_ms": statistics.median(means[True]) * 1e3,
+            "overlapped_mean_ms": statistics.median(means[False]) * 1e3,
+            "overlapped_device_ms": statistics.median(device)}
+
+
+def host_parts(session, cameras, rounds: int = 3) -> dict:
+    """A frame's host time split into its steps (``Session.tessellate``'s, one by one), median
+    µs over the frames: the request for the camera, program look-up (skipped for a new camera
+    alone where the tree does), stages 1-3 enqueued, the wait for their totals, stages 4-5
+    enqueued, the wait for them and the result, and the read-back to host arrays (and its
+    wait).  The waits are timed by wrapping ``pyopencl.wait_for_events``, through which every
+    tree waits, so that the script gives the same split for a tree before this one."""
+    tessellator, clock = session.tessellator, time.perf_counter_ns
+    parts = {name: [] for name in ("request", "compose", "stages 1-3 (host)", "totals wait", "stages 4-5 (host)",
+                                   "stages 4-5 wait + result", "of which wait", "fetch (host arrays)",
+                                   "of which read-back wait", "host, total", "wall, total")}
+    key = session.request.sharp_edges
+    waits, wait_for_events = [], cl.wait_for_events
+
+    def timed_wait(events):
+        started = clock()
+        wait_for_events(events)
+        waits.append(clock() - started)
+
+    cl.wait_for_events = timed_wait
+    try:
+        for _ in range(rounds):
+            for camera in cameras:
+                waits.clear()
+                t0 = clock()
+                request = session.request_for(camera)
+                t1 = clock()
+                if getattr(session, "_composed", None) is None:  # (a tree before the skip: every frame)
+                    tessellator.compose(session.scene, request)
+                t2 = clock()
+                plan = tessellator.plan_on(session._scene_data[key], request, None, session._scratch[key])
+                t3 = clock()
+                pending = tessellator.emit_async(plan, 0, plan.num_patches, out=session.output)
+                t4 = clock()
+                frame = pending.result(on_device=True)
+                t5 = clock()
+                frame.fetch()
+                t6 = clock()
+                totals, stages45, read_back = (waits + [0, 0, 0])[:3]
+                for name, value in (("request", t1 - t0), ("compose", t2 - t1),
+                                    ("stages 1-3 (host)", t3 - t2 - totals), ("totals wait", totals),
+                                    ("stages 4-5 (host)", t4 - t3), ("stages 4-5 wait + result", t5 - t4),
+                                    ("of which wait", stages45), ("fetch (host arrays)", t6 - t5),
+                                    ("of which read-back wait", read_back),
+                                    ("host, total", t6 - t0 - sum(waits)), ("wall, total", t6 - t0)):
+                    parts[name].append(value / 1e3)
+    finally:
+        cl.wait_for_events = wait_for_events
+    return {name: statistics.median(values) for name, values in parts.items()}
 
 
 def median(rows: list[dict], key: str) -> float:
@@ -187,12 +278,45 @@ def frame_loop(tessellator, key: str, count: int) -> dict:
     path = list(orbit(scene.camera, count))
     session.tessellate(camera=path[0]).fetch()  # builds, uploads, host adjacency
     setup = time.perf_counter() - started
+    for camera in path:  # the output buffers at the size the path needs
+        session.tessellate(camera=camera)
     resident = frames(session, path, host=False)
     held = frames(session, path, host=True)
     return {"scene": key, "setup_s": setup, "frames": count,
             "triangles": median(resident, "triangles"), "device_ms": median(resident, "device_ms"),
-            "resident_wall_ms": median(resident, "stages_wall_ms"), "host_wall_ms": median(held, "total_wall_ms"),
-            "host_device_ms": median(held, "device_ms"), "read_back_ms": median(held, "read_back_ms")}
+            "resident_wall_ms": median(resident, "stages_wall_ms"), "resident_host_ms": median(resident, "host_ms"),
+            "host_wall_ms": median(held, "total_wall_ms"), "host_host_ms": median(held, "host_ms"),
+            "host_device_ms": median(held, "device_ms"), "read_back_ms": median(held, "read_back_ms"),
+            **(overlapped(session, path) if OVERLAPS else {}), "parts": host_parts(session, path)}
+
+
+#: Whether this cltess has Session.tessellate(wait=False) (the script also runs on older trees
+#: through PYTHONPATH, for before/after figures).
+OVERLAPS = "wait" in inspect.signature(cltess.Session.tessellate).parameters
+
+
+def frame_report(record: dict) -> list[str]:
+    lines = [f"Frame loop, {record['frames']} cameras per scene, {PIXELS} px (median per frame, ms; device: the "
+             "stages' profiling spans; host: wall minus the waits for the device; overlapped: "
+             "Session.tessellate(wait=False), the median interval between returns over 3 loops; looped: the "
+             "same loop with frames that wait):", "",
+             "| scene | triangles | device | on device: wall | host | ratio | host arrays: wall | host | ratio | "
+             "looped: wall | overlapped: wall | ratio | setup s |", "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for f in record["frame_loop"]:
+        lines.append(f"| {f['scene']} | {f['triangles']:,.0f} | {f['device_ms']:.3f} | {f['resident_wall_ms']:.3f} | "
+                     f"{f['resident_host_ms']:.3f} | {f['resident_wall_ms'] / f['device_ms']:.2f}x | "
+                     f"{f['host_wall_ms']:.3f} | {f['host_host_ms']:.3f} | "
+                     f"{f['host_wall_ms'] / f['host_device_ms']:.2f}x | {f.get('looped_wall_ms', math.nan):.3f} | "
+                     f"{f.get('overlapped_wall_ms', math.nan):.3f} | "
+                     f"{f.get('overlapped_wall_ms', math.nan) / f.get('overlapped_device_ms', 1.0):.2f}x | "
+                     f"{f['setup_s']:.1f} |")
+    names = list(record["frame_loop"][0]["parts"]) if record["frame_loop"] else []
+    lines += ["", "A frame's host time by step (µs, median; Session.tessellate's steps one by one, then fetch):", "",
+              "| step | " + " | ".join(f["scene"] for f in record["frame_loop"]) + " |",
+              "|---|" + "---|" * len(record["frame_loop"])]
+    for name in names:
+        lines.append(f"| {name} | " + " | ".join(f"{f['parts'][name]:.0f}" for f in record["frame_loop"]) + " |")
+    return lines
 
 
 # --- 2. uniform level 16 -----------------------------------------------------------------------
@@ -426,21 +550,40 @@ def report(record: dict) -> str:
     lines += ["", f"Read-back: {gb(level['read_back_bytes_per_s'])} GB/s = "
               f"{100 * level['read_back_bytes_per_s'] / band['pinned_read_bytes_per_s']:.0f}% of the pinned copy rate "
               f"(on a CPU device the read-back is a mapping: no copy).", ""]
-    lines += [f"Frame loop, {record['frames']} cameras per scene, {PIXELS} px (median per frame, ms):", "",
-              "| scene | triangles | device | wall, output on device | ratio | wall, host arrays | ratio | "
-              "of which read-back | setup s |", "|---|---|---|---|---|---|---|---|---|"]
-    for f in record["frame_loop"]:
-        lines.append(f"| {f['scene']} | {f['triangles']:,.0f} | {f['device_ms']:.2f} | {f['resident_wall_ms']:.2f} | "
-                     f"{f['resident_wall_ms'] / f['device_ms']:.2f}x | {f['host_wall_ms']:.2f} | "
-                     f"{f['host_wall_ms'] / f['host_device_ms']:.2f}x | {f['read_back_ms']:.2f} | {f['setup_s']:.1f} |")
-    lines += ["", "Against a one-thread NumPy grid (uniform factor f, ms; cltess: host arrays held):", "",
-              "| patches | f | triangles | NumPy grid | cltess session frame | (its device time) | cltess one-shot | "
-              "NumPy / session |", "|---|---|---|---|---|---|---|---|"]
+    lines += frame_report(record)
+    lines += grid_report(record)
+    return "\n".join(lines)
+
+
+def grid_report(record: dict) -> list[str]:
+    lines = ["", "Against a one-thread NumPy grid (uniform factor f, ms; cltess: host arrays held):", "",
+             "| patches | f | triangles | NumPy grid | cltess session frame | (its device time) | cltess one-shot | "
+             "NumPy / session |", "|---|---|---|---|---|---|---|---|"]
     for g in record["grid"]:
         lines.append(f"| {g['patches']:,} | {g['factor']} | {g['triangles']:,} | {g['numpy_ms']:.2f} | "
                      f"{g['session_host_ms']:.2f} | {g['session_device_ms']:.2f} | {g['one_shot_ms']:.2f} | "
                      f"{g['numpy_ms'] / g['session_host_ms']:.1f}x |")
-    return "\n".join(lines)
+    return lines
+
+
+def frames_only(tessellator, record: dict, keys: list, args) -> int:
+    """--frames-only: section 3 (the frame loop, with the host time by step) and section 4."""
+    record["frame_loop"] = []
+    for key in keys:
+        say(f"frame loop: {key}")
+        record["frame_loop"].append(frame_loop(tessellator, key, args.frames))
+    lines = [f"Device: {record['device']['name']} ({record['device']['platform']}); load average before "
+             f"{record['load_before']}; default work distribution {record['default_work']}; fused stage 3 "
+             f"{tessellator.fused_offsets}.", ""] + frame_report(record)
+    if args.grid_copies:
+        say("NumPy grid")
+        record["grid"] = grid_sizes(tessellator, [(copies, 13) for copies in args.grid_copies], args.repeat)
+        lines += grid_report(record)
+    record["load_after"] = [round(x, 1) for x in os.getloadavg()]
+    print("\n".join(lines + ["", f"Load average after: {record['load_after']}."]))
+    if args.json:
+        Path(args.json).write_text(json.dumps(record, indent=1, default=float) + "\n")
+    return 0
 
 
 def main(argv=None) -> int:
@@ -458,6 +601,11 @@ def main(argv=None) -> int:
                              f"'gpu': {' '.join(GPU_VARIANTS)}; default: {' '.join(VARIANTS)})")
     parser.add_argument("--variants-only", action="store_true",
                         help="bandwidth and the work distributions side by side only (no frame loop, no NumPy grid)")
+    parser.add_argument("--frames-only", action="store_true",
+                        help="the frame loop (device, host and wall per frame; the host time by step) and the "
+                             "NumPy grid only")
+    parser.add_argument("--grid-copies", type=int, nargs="*", default=[1, 10, 100, 1000],
+                        help="teapots of the NumPy grid's sizes (factor 13: 10,712 triangles per teapot)")
     args = parser.parse_args(argv)
     args.work = [w for work in args.work for w in (GPU_VARIANTS if work == "gpu" else [work])]
     for work in args.work:
@@ -470,10 +618,12 @@ def main(argv=None) -> int:
     record = {"device": device_info(tessellator.device), "machine": machine_info(), "frames": args.frames,
               "command": " ".join(sys.argv), "date": time.strftime("%Y-%m-%d %H:%M:%S %z"),
               "load_before": [round(x, 1) for x in os.getloadavg()], "default_work": tessellator.work}
+    keys = resolve_scenes(args.scenes)
+    if args.frames_only:
+        return frames_only(tessellator, record, keys, args)
     say("bandwidth")
     size = min(args.bandwidth_mib << 20, tessellator.device.max_mem_alloc_size // 2)
     record["bandwidth"] = bandwidths(tessellator, size)
-    keys = resolve_scenes(args.scenes)
     level16 = teapots(args.copies)
     scenes = [(f"uniform 16 ({level16.num_patches:,} patches)", level16, uniform_request(16))]
     scenes += [(key, suite_scene(key), {"pixels": PIXELS}) for key in keys]
@@ -489,7 +639,7 @@ def main(argv=None) -> int:
             say(f"frame loop: {key}")
             record["frame_loop"].append(frame_loop(tessellator, key, args.frames))
         say("NumPy grid")
-        sizes = [(1, 13), (10, 13), (100, 13), (1000, 13)]  # about 10k, 100k, 1M, 10M triangles
+        sizes = [(copies, 13) for copies in args.grid_copies]  # 1, 10, 100, 1000: 10k, 100k, 1M, 10M triangles
         record["grid"] = grid_sizes(tessellator, sizes, args.repeat)
     record["load_after"] = [round(x, 1) for x in os.getloadavg()]
     print(report(record))

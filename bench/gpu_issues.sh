@@ -6,6 +6,8 @@
 #   bash bench/gpu_issues.sh OUTDIR patterns   # bench/silhouette.py, bench/sd2.py, bench/esc.py
 #   bash bench/gpu_issues.sh OUTDIR kernels    # issue 15's work distributions side by side, bitwise tests
 #   bash bench/gpu_issues.sh OUTDIR gpu15      # the same with prepared patches, :direct, fused stage 3
+#   bash bench/gpu_issues.sh OUTDIR frame15 [BASELINE_TREE]  # a frame's device, host and wall time, by step;
+#                                              # with a tree before (git archive): the same for it, then frame_host
 #
 # Expects in .whl/ the Python 3.12 manylinux x86_64 wheels of pyopencl and its dependencies,
 # mako, trimesh, tqdm (as bench/gpu_run.sh) and NVIDIA's OpenCL library in
@@ -13,7 +15,7 @@
 # take the others with it; its output and exit code are in OUTDIR.
 set -u
 out=${1:?usage: bash bench/gpu_issues.sh OUTDIR speed|patterns}
-which=${2:?usage: bash bench/gpu_issues.sh OUTDIR speed|patterns|kernels|gpu15}
+which=${2:?usage: bash bench/gpu_issues.sh OUTDIR speed|patterns|kernels|gpu15|frame15}
 . bench/gpu_setup.sh
 { nvidia-smi -L; python3 -m cltess devices; } > "$out/machine-$which.txt" 2>&1
 run() {  # run NAME SECONDS COMMAND...
@@ -36,4 +38,12 @@ case $which in
   gpu15)  # issue 15 on the GPU: prepared patches, direct evaluation, stage 3 in one launch (branch gpu15)
     run frame_loop_gpu15 500 python3 bench/frame_loop.py --device nvidia --variants-only --work gpu --scenes tea_table killeroo herd spheres model_zoo --json "$out/frame_loop_gpu15.json"
     run gpu15_tests 200 env CLTESS_DEVICE=nvidia python3 -m pytest -q -p no:cacheprovider tests/test_work_points.py tests/test_fused_offsets.py tests/test_counts.py ;;
+  frame15)  # issue 15, a frame's host cost (branch frame15): the paper's scenes, then the tree before if given
+    scenes="tea_table double_torus killeroo herd spheres star_field model_zoo"
+    run frame_loop_frames 200 python3 bench/frame_loop.py --device nvidia --frames-only --scenes $scenes --grid-copies 1 10 --json "$out/frame_loop_frames.json"
+    run frame15_tests 150 env CLTESS_DEVICE=nvidia python3 -m pytest -q -p no:cacheprovider tests/test_frame_host.py tests/test_session.py tests/test_fused_offsets.py
+    if [ -n "${3:-}" ]; then
+      run frame_loop_frames_base 200 env PYTHONPATH="$3" python3 bench/frame_loop.py --device nvidia --frames-only --scenes $scenes --grid-copies 1 10 --json "$out/frame_loop_frames_base.json"
+      run frame_host 240 python3 bench/frame_host.py --device nvidia --frames 20 --repeat 2 --scenes $scenes --baseline "$3" --json "$out/frame_host.json"
+    fi ;;
 esac

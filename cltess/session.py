@@ -50,6 +50,7 @@ class Session:
         self._scene_data: dict = {}  # sharp_edges -> SceneData
         self._scratch: dict = {}  # sharp_edges -> the per-patch arrays of stages 1-3
         self.frames = 0
+        self._composed = None  # the (work, fused_offsets) of the last frame composed for the session's request
 
     @property
     def device(self):
@@ -71,26 +72,44 @@ class Session:
                 raise ValueError("camera= is for a pixel tolerance; this session's is eps "
                                  f"{tolerance.eps!r} (give pixels= to the session or to this call)")
             tolerance = ScreenSpace(tolerance.pixels, camera)
+        if camera is not None and not overrides and tolerance.pixels == getattr(request.tolerance, "pixels", None):
+            # A new camera alone: the request as it was, with this tolerance (its fields were
+            # checked when it was made; check() asks for a camera, which there now is).
+            framed = object.__new__(type(request))
+            framed.__dict__.update(request.__dict__, tolerance=tolerance)
+            return framed
         if tolerance is not request.tolerance or overrides:
             request = dataclasses.replace(request, tolerance=tolerance, **overrides)
             request.check(self.scene)
         return request
 
-    def tessellate(self, camera: Camera | None = None, **request_overrides) -> Tessellation:
+    def tessellate(self, camera: Camera | None = None, wait: bool = True, **request_overrides) -> Tessellation:
         """One frame: stages 1-5 for the whole scene with this camera (pixel tolerance) and
         these changes to the session's request (``request_for``).  The output stays on the
-        device (``.device``); host arrays on first use, valid until the next call."""
+        device (``.device``); host arrays on first use, valid until the next call.
+
+        wait=False: return once stages 4-5 are enqueued, without waiting for them, so that the
+        host's work until the next frame (drawing, the next camera, the next frame's stages 1-3)
+        overlaps them on the device.  Commands on the session's queue (``device.queue``,
+        in order) see the finished output; anything else waits with ``frame.finish()`` (also
+        the first look at ``frame.stage_ms``, ``frame.wall_ms`` or a host array waits).  The
+        next frame waits for this one's stages anyway (its stages 1-3 read back two totals)."""
         started = time.perf_counter()
         request = self.request_for(camera, **request_overrides)
         tessellator = self.tessellator
-        tessellator.compose(self.scene, request)  # found in the cache after the first frame
+        # A new camera alone needs the programs of the last frame (they depend on the tolerance's
+        # kind, not its camera); anything else is looked up (compose: found in the cache).
+        composed = None if request_overrides else (tessellator.work, tessellator.fused_offsets)
+        if composed is None or composed != self._composed:
+            tessellator.compose(self.scene, request)
+            self._composed = composed
         key = request.sharp_edges
         if key not in self._scene_data:
             self._scene_data[key] = tessellator.scene_data(self.scene, key)
             self._scratch[key] = {}
         plan = tessellator.plan_on(self._scene_data[key], request, started, self._scratch[key])
         self.frames += 1
-        return tessellator.emit(plan, 0, plan.num_patches, on_device=True, out=self.output)
+        return tessellator.emit_async(plan, 0, plan.num_patches, out=self.output).result(on_device=True, wait=wait)
 
     def __repr__(self) -> str:
         return (f"Session({self.scene.name!r}, {self.device.name.strip()!r}, {self.frames} frames, "

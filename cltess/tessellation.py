@@ -116,6 +116,9 @@ class Tessellation(IndexedMesh):
                 "total" both: until the caller holds the host arrays.  A device-resident result
                 (``device``) has no "read_back" until its arrays are fetched, and "total" then
                 is "stages" + "read_back" (the time the caller spent between is not counted).
+                "waits" (the OpenCL backend's five stages): of those, the ms the host was
+                blocked waiting for the device (stages 1-3's totals, stages 4-5, the read-back's
+                maps or copies); the rest is host work: Python, launches, copies' set-up.
     device:     the output on the device (:class:`DeviceOutput`), or None (host arrays only).
     strips:     (S,) uint32 triangle strips of the strip patterns' patches (SD-2, ESC), restart-
                 separated (cltess.strips), or None; they expand to those patches' triangles
@@ -139,17 +142,35 @@ class Tessellation(IndexedMesh):
     real_factors: np.ndarray | None = None
 
     @classmethod
-    def on_device(cls, device: DeviceOutput, stage_ms: dict, stats: dict, wall_ms: dict,
-                  strips: np.ndarray | None = None) -> "Tessellation":
+    def on_device(cls, device: DeviceOutput, stage_ms: dict | None, stats: dict, wall_ms: dict | None,
+                  strips: np.ndarray | None = None, finish=None) -> "Tessellation":
         """A result whose host arrays (and factors) are read back from ``device`` when first
-        asked for (strips, when a pattern makes them, are host arrays already)."""
+        asked for (strips, when a pattern makes them, are host arrays already).  finish: for a
+        result whose stages may still run (``Session.tessellate(wait=False)``), a function that
+        waits for them and sets ``stage_ms`` and ``wall_ms`` (given as None); called by
+        ``finish()`` or the first look at either."""
         tess = object.__new__(cls)
-        tess.stage_ms, tess.stats, tess.wall_ms, tess.device = stage_ms, stats, wall_ms, device
-        tess.strips = strips
+        tess.stats, tess.device, tess.strips = stats, device, strips
+        if stage_ms is not None:
+            tess.stage_ms, tess.wall_ms = stage_ms, wall_ms
+        if finish is not None:
+            tess._finish = finish
         return tess
 
+    def finish(self) -> "Tessellation":
+        """Wait until the device stages of this result are done (a no-op when they were
+        waited for already: every result but ``Session.tessellate(wait=False)``'s)."""
+        finish = self.__dict__.pop("_finish", None)
+        if finish is not None:
+            finish(self)
+        return self
+
     def __getattr__(self, name):
-        # Called only for attributes not set: the host arrays of a device-resident result.
+        # Called only for attributes not set: the host arrays of a device-resident result, and
+        # the times of one whose stages were not waited for.
+        if name in ("stage_ms", "wall_ms") and "_finish" in self.__dict__:
+            self.finish()
+            return self.__dict__[name]
         if name in HOST_FIELDS and self.__dict__.get("device") is not None:
             self.fetch()
             return self.__dict__[name]
@@ -166,6 +187,7 @@ class Tessellation(IndexedMesh):
         if self.on_host:
             return self
         self.device.check()
+        self.finish()
         started = time.perf_counter()
         self.__dict__.update(self.device.read_back())
         self.wall_ms["read_back"] = (time.perf_counter() - started) * 1e3

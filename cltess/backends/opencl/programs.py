@@ -60,6 +60,33 @@ WORK_STAGES = {"rows": ("vertex_rows",), "vertex": ("vertex_points",), "point": 
                "vertex-prep": ("prepared_points",), "point-prep": ("prepared_points", "triangles")}
 
 
+class Kernel:
+    """A built kernel whose scalar arguments' C types are fixed at its first launch, from the
+    NumPy scalars it was given (``pyopencl.Kernel.set_arg_types``): later launches pack each
+    scalar with ``struct`` (0.3 us) instead of pyopencl's generic ``set_arg`` of a NumPy
+    scalar (9 us each on Intel's CPU runtime and PoCL, bench/RESULTS.md "Issue 15: a frame's
+    host cost"; a frame sets about 20).  Buffers, ``LocalMemory`` and anything but a NumPy
+    scalar keep the generic path.  Every call site passes a kernel parameter the same NumPy
+    type each time (the kernel's C type); a later value of another type is packed as the first
+    call's type, or refused by ``struct`` (out of range, wrong kind), never reinterpreted.
+    Anything else (``get_work_group_info``, ``function_name``) is the pyopencl kernel's."""
+
+    __slots__ = ("kernel", "arg_types")
+
+    def __init__(self, kernel: cl.Kernel):
+        self.kernel = kernel
+        self.arg_types = None
+
+    def __call__(self, queue, global_size, local_size, *args, **options) -> cl.Event:
+        if self.arg_types is None:
+            self.arg_types = tuple(a.dtype if isinstance(a, np.generic) else None for a in args)
+            self.kernel.set_arg_types(self.arg_types)
+        return self.kernel(queue, global_size, local_size, *args, **options)
+
+    def __getattr__(self, name):
+        return getattr(self.kernel, name)
+
+
 def kernel_dir() -> Path:
     """Folder of the kernel sources (top-level kernels/, installed as cltess.kernels)."""
     return Path(str(resources.files("cltess.kernels")))
@@ -110,6 +137,7 @@ class Programs:
         self.context = context
         self._programs: dict = {}
         self._kernels: dict = {}
+        self._seen: dict = {}  # Programs.kernel's look-up by the identity of its arguments
         self.offsets_scan = GenericScanKernel(
             context, np.uint64, arguments="__global const ulong *counts, __global ulong *offsets",
             input_expr="counts[i]", scan_expr="a+b", neutral="0",
@@ -127,15 +155,27 @@ class Programs:
             neutral="offset_pair_of(0, 0)",
             output_statement="vertex_offsets[i + 1] = item.v; index_offsets[i + 1] = item.i;")
 
-    def kernel(self, stage: str, entry: str | None = None, **axes) -> cl.Kernel:
-        """The stage's kernel composed for ``axes`` (kind=, pattern=, tolerance=, crack=): the
-        one named as the stage, or ``entry`` where its file holds several."""
+    def kernel(self, stage: str, entry: str | None = None, kind=None, pattern=None, tolerance=None,
+               crack: str = "crack/max.h") -> Kernel:
+        """The stage's kernel composed for kind=, pattern=, tolerance=, crack=: the one named as
+        the stage, or ``entry`` where its file holds several.  Found again by the identity of
+        the kind and pattern (registry objects, kept alive by the entry) and the tolerance's
+        class (its defines are the class's): a frame looks up each of its kernels this way."""
+        seen = (stage, entry, id(kind), id(pattern), type(tolerance), crack)
+        found = self._seen.get(seen)
+        if found is not None:
+            return found[0]
+        found = self._kernel(stage, entry, kind=kind, pattern=pattern, tolerance=tolerance, crack=crack)
+        self._seen[seen] = (found, kind, pattern)
+        return found
+
+    def _kernel(self, stage: str, entry: str | None, **axes) -> Kernel:
         headers, defines = composition(stage, **axes)
         key = (stage, headers, tuple(sorted(defines.items())))
         if key not in self._programs:
             self._programs[key] = self.build(stage, headers, defines)
         if (key, entry) not in self._kernels:  # one Kernel object each: pyopencl caches its call set-up
-            self._kernels[key, entry] = getattr(self._programs[key], entry or stage)
+            self._kernels[key, entry] = Kernel(getattr(self._programs[key], entry or stage))
         return self._kernels[key, entry]
 
     def compose(self, kind, pattern, tolerance, work: str = "patch") -> None:

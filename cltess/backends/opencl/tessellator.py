@@ -74,6 +74,11 @@ DEFAULT_WORK = {"gpu": "point", "other": "patch"}
 #: the H100 one launch took 0.03 ms against the scans' 0.14-0.25 ms up to 1,536 patches, 0.17
 #: against 0.14 at 11,532 and 0.71 against 0.19 at 32,000 (bench/RESULTS.md, issue 15 on the H100).
 FUSED_OFFSETS_MAX_PATCHES = 1 << 13
+#: The same on a CPU device (one work-group runs on one core): measured on Intel's runtime and PoCL
+#: (2 vCPUs), a frame took 0.1 ms less fused than with the counts kernel and pyopencl.scan at 332
+#: and 1,536 patches (mostly the scan's host cost: two temporary arrays and three launches per call),
+#: the same within noise at 11,532 (bench/RESULTS.md, "Issue 15: a frame's host cost").
+FUSED_OFFSETS_MAX_PATCHES_CPU = 1 << 11
 #: The fused launch's work-group size at most (a power of two; less where the device says so).
 FUSED_OFFSETS_GROUP = 1024
 
@@ -92,14 +97,21 @@ def shared_context(device: cl.Device) -> cl.Context:
 
 
 def default_fused_offsets(device: cl.Device) -> bool:
-    """Stage 3 by stages/offsets.cl: ``CLTESS_FUSED_OFFSETS`` (0 or 1) if set, else on GPUs
-    (one work-group: a GPU saves launches, a CPU would run stage 3 on one core)."""
+    """Stage 3 by stages/offsets.cl: ``CLTESS_FUSED_OFFSETS`` (0 or 1) if set, else on GPUs and
+    on CPUs (one work-group: a GPU saves launches; on a CPU, where it runs on one core, only up to
+    ``FUSED_OFFSETS_MAX_PATCHES_CPU`` patches, ``Tessellator.stage_counts``).  Not on a device
+    that says it is both (Oclgrind: "all")."""
     chosen = os.environ.get("CLTESS_FUSED_OFFSETS")
     if chosen not in (None, "", "0", "1"):
         raise ValueError(f"CLTESS_FUSED_OFFSETS={chosen!r}: expected 0 or 1")
     if chosen:
         return chosen == "1"
-    return bool(device.type & cl.device_type.GPU and not device.type & cl.device_type.CPU)
+    return bool(device.type & cl.device_type.GPU) != bool(device.type & cl.device_type.CPU)
+
+
+def pure_cpu(device: cl.Device) -> bool:
+    """A CPU device and nothing else (Oclgrind says "all")."""
+    return bool(device.type & cl.device_type.CPU and not device.type & cl.device_type.GPU)
 
 
 def default_work(device: cl.Device) -> str:
@@ -146,9 +158,19 @@ def _record_groups(records: int, per_item: int) -> tuple[int]:
     return (max(1, -(-records // per_group)) * WORK_GROUP,)
 
 
+def wait_ms(events) -> float:
+    """Wait for events; the host milliseconds spent blocked (a frame's wall_ms["waits"])."""
+    started = time.perf_counter()
+    cl.wait_for_events(events)
+    return (time.perf_counter() - started) * 1e3
+
+
 def _span_ms(events) -> float:
     """Device milliseconds from the first event's start to the last one's end."""
-    return (events[-1].profile.end - events[0].profile.start) * 1e-6
+    return (events[-1].get_profiling_info(_END) - events[0].get_profiling_info(_START)) * 1e-6
+
+
+_START, _END = cl.profiling_info.START, cl.profiling_info.END
 
 
 class Tessellator:
@@ -176,6 +198,7 @@ class Tessellator:
         self.programs = Programs.of(self.context)
         self._prepared = None  # work="*-prep": the prepared patches' scratch buffer (_prepared_points)
         self.fused_offsets = default_fused_offsets(self.device)  # stage 3 by stages/offsets.cl
+        self._cpu = pure_cpu(self.device)  # stage 3 fused up to FUSED_OFFSETS_MAX_PATCHES_CPU only
         self._kind_patch_sizes: dict = {}
 
     @property
@@ -302,7 +325,7 @@ class Tessellator:
         events["counts"] += strips[1]
         totals = np.zeros(2, np.uint64)  # the two read-backs, and the flags, waited for at once
         flag_values = np.empty(count, np.int32)
-        cl.wait_for_events([
+        waited = wait_ms([
             cl.enqueue_copy(self.queue, totals[:1], vertex_offsets.data, src_offset=8 * count, is_blocking=False),
             cl.enqueue_copy(self.queue, totals[1:], index_offsets.data, src_offset=8 * count, is_blocking=False),
             cl.enqueue_copy(self.queue, flag_values, flags.data, is_blocking=False)])
@@ -325,7 +348,7 @@ class Tessellator:
                 [read_back["factors"][p.base:p.base + p.count] for p in parts if p.pattern.dyadic]))
         return Plan(scene.name, count, parts, data.objects, final, vertex_offsets, index_offsets,
                     num_vertices, num_indices, stats, events, started, request, _host=read_back,
-                    strip_offsets=strips[0], num_strip_indices=num_strip_indices)
+                    strip_offsets=strips[0], num_strip_indices=num_strip_indices, wait_ms=waited)
 
     def upload_groups(self, groups, num_patches: int) -> dict:
         """Stage 2's edge groups (cltess.crack.adjacency.EdgeGroups over the P * 4 edge slots)
@@ -556,7 +579,8 @@ class Tessellator:
                 scratch[name] = cl_array.zeros(self.queue, count + 1, np.uint64)
         vertex_counts, index_counts = scratch["vertex_counts"], scratch["index_counts"]
         vertex_offsets, index_offsets = scratch["vertex_offsets"], scratch["index_offsets"]
-        fused = self.fused_offsets and count <= FUSED_OFFSETS_MAX_PATCHES and not any(
+        cap = min(FUSED_OFFSETS_MAX_PATCHES, FUSED_OFFSETS_MAX_PATCHES_CPU) if self._cpu else FUSED_OFFSETS_MAX_PATCHES
+        fused = self.fused_offsets and count <= cap and not any(
             _pattern(k).counts_walk for k, _, n in ranges if n)  # a walk per patch wants the whole device
         if fused:  # one launch per range, in order
             events = [self._fused_offsets(_pattern(k), factors, base, n, vertex_counts, index_counts,
@@ -754,7 +778,7 @@ class _Ready:
 
     tessellation: Tessellation
 
-    def result(self, on_device: bool = False) -> Tessellation:
+    def result(self, on_device: bool = False, wait: bool = True) -> Tessellation:
         return self.tessellation
 
 
@@ -773,26 +797,37 @@ class PendingEmit:
     buffers: "OutputBuffers"
     strips: np.ndarray | None = None  # host strips of a strip pattern (cltess.strips)
 
-    def result(self, on_device: bool = False) -> Tessellation:
+    def result(self, on_device: bool = False, wait: bool = True) -> Tessellation:
+        """The Tessellation.  wait=False (with on_device): return at once, the stages still
+        running; the first look at its ``stage_ms``, ``wall_ms`` or host arrays, or
+        ``finish()``, waits for them (commands on the same in-order queue need no wait)."""
+        if not wait and not on_device:
+            raise ValueError("wait=False leaves the output on the device: give on_device=True too")
         plan, first, last, buffers, arrays = self.plan, self.first, self.last, self.buffers, self.arrays
-        all_events = [event for evs in self.events.values() for event in evs]
-        if all_events:
-            cl.wait_for_events(all_events)
-        stage_ms = {stage: _span_ms(evs) for stage, evs in self.events.items() if evs}
-        wall_ms = {"stages": (time.perf_counter() - plan.started) * 1e3}
-        stage_ms["total_wall"] = wall_ms["stages"]  # until the host arrays are there: Tessellation.fetch
         stats = dict(plan.stats, first_patch=first, last_patch=last)
-        generation = buffers.generation
+        generation, events, times = buffers.generation, self.events, {}
 
-        def read_back() -> dict:
+        def finish(tess: Tessellation) -> None:  # wait for the stages; their times
+            all_events = [event for evs in events.values() for event in evs]
+            waited = wait_ms(all_events) if all_events else 0.0
+            tess.stage_ms = {stage: _span_ms(evs) for stage, evs in events.items() if evs}
+            tess.wall_ms = times["wall_ms"] = {"stages": (time.perf_counter() - plan.started) * 1e3,
+                                               "waits": (plan.wait_ms if first == 0 else 0.0) + waited}
+            tess.stage_ms["total_wall"] = tess.wall_ms["stages"]  # until the host arrays: Tessellation.fetch
+
+        def read_back() -> dict:  # (Tessellation.fetch has waited for the stages: finish)
             plan.enqueue_host_factors()  # with the output's copies or maps: one wait for all
             host = buffers.read_back(arrays.num_vertices, arrays.num_triangles)
+            if "wall_ms" in times:
+                times["wall_ms"]["waits"] += buffers.read_back_wait_ms
             host["factors"], host["real_factors"] = plan.output_factors(first, last)
             return host
 
         device = DeviceOutput(arrays, self.tessellator.queue, self.vertex_base, read_back,
                               valid=lambda: buffers.generation == generation)
-        tess = Tessellation.on_device(device, stage_ms, stats, wall_ms, self.strips)
+        tess = Tessellation.on_device(device, None, stats, None, self.strips, finish=finish)
+        if wait:
+            tess.finish()
         if not on_device:
             tess.fetch()
             tess.device = None  # the device buffers go when the caller drops nothing but the host arrays
@@ -806,8 +841,8 @@ class OutputBuffers:
 
     How the output reaches host arrays (``read_back``) depends on the device:
 
-    * a CPU device: the buffers are allocated with ``CL_MEM_ALLOC_HOST_PTR`` and *mapped*: the
-      host arrays are the buffers' own memory, no copy;
+    * a CPU device: the buffers are sub-buffers of one allocation with ``CL_MEM_ALLOC_HOST_PTR``,
+      *mapped* at once: the host arrays are the buffers' own memory, no copy (``_take_mapped``);
     * another device with ``pinned=True`` (a ``Session``): copied into page-locked host buffers
       (``ALLOC_HOST_PTR``, mapped once and kept), which DMA engines fill at the bus's rate;
     * otherwise copied into fresh (pageable) NumPy arrays.
@@ -828,6 +863,9 @@ class OutputBuffers:
         self._buffers: dict = {}  # name -> (device buffer, capacity in rows)
         self._staging: dict = {}  # name -> (pinned buffer, its mapped host array)
         self._maps: list = []
+        self.read_back_wait_ms = 0.0  # host ms blocked in the last read_back
+        self._parent = None  # a mapped device's one allocation (_take_mapped), its fields' offsets
+        self._offsets: dict = {}
 
     #: (name, dtype, per-row shape) of every output buffer: the vertex record, then triangles.
     LAYOUT = tuple((name, np.dtype(dtype), shape) for name, dtype, shape in VERTEX_RECORD) + \
@@ -842,8 +880,12 @@ class OutputBuffers:
         triangles, on buffers at least that large; a new generation."""
         self.generation += 1
         self.unmap()
-        flags = cl.mem_flags.READ_WRITE | (cl.mem_flags.ALLOC_HOST_PTR if self.mapped else 0)
         layout = self._layout()
+        if self.mapped:
+            self._take_mapped(layout, num_vertices, num_triangles)
+            return OutputArrays(self.queue, layout, {name: self._buffers[name][0] for name, _, _ in layout},
+                                num_vertices, num_triangles)
+        flags = cl.mem_flags.READ_WRITE
         for name, dtype, shape in layout:
             rows = num_triangles if name == "triangles" else num_vertices
             row_bytes = dtype.itemsize * math.prod(shape)
@@ -857,9 +899,44 @@ class OutputBuffers:
         return OutputArrays(self.queue, layout, {name: self._buffers[name][0] for name, _, _ in layout},
                             num_vertices, num_triangles)
 
+    def _take_mapped(self, layout, num_vertices: int, num_triangles: int) -> None:
+        """A CPU device's buffers: every field a sub-buffer of one ``ALLOC_HOST_PTR`` allocation
+        (each at a multiple of the device's base address alignment), so that ``read_back`` maps
+        once: one map and one release a frame instead of six (measured: 9 against 44 µs on
+        Intel's runtime, 38 against 113 on PoCL).  Grown as a whole when a field needs more."""
+        rows_of = {name: num_triangles if name == "triangles" else num_vertices for name, _, _ in layout}
+        if self._parent is not None and all(rows_of[name] <= self._buffers[name][1] for name in rows_of):
+            return
+        capacities = {}
+        for name, rows in rows_of.items():  # the first allocation as asked; growing, a quarter more
+            kept = -1 if self._parent is None else self._buffers[name][1]
+            capacities[name] = kept if rows <= kept else rows if self._parent is None else int(rows * self.GROWTH)
+        align = max(1, self.queue.device.mem_base_addr_align // 8)
+        offsets, end = {}, 0
+        for name, dtype, shape in layout:
+            offsets[name] = end
+            end += -(-max(capacities[name], 1) * dtype.itemsize * math.prod(shape) // align) * align
+        self._buffers.clear()
+        self._parent = cl.Buffer(self.context, cl.mem_flags.READ_WRITE | cl.mem_flags.ALLOC_HOST_PTR, end)
+        for name, dtype, shape in layout:
+            size = max(capacities[name], 1) * dtype.itemsize * math.prod(shape)
+            self._buffers[name] = (self._parent.get_sub_region(offsets[name], size), capacities[name])
+        self._offsets = offsets
+
     def read_back(self, num_vertices: int, num_triangles: int) -> dict:
         """The current generation's output as host arrays (see the class)."""
         host, events = {}, []
+        if self.mapped:  # one map of the whole allocation; each field a view of it
+            memory, event = cl.enqueue_map_buffer(self.queue, self._parent, cl.map_flags.READ | cl.map_flags.WRITE,
+                                                  0, (self._parent.size,), np.uint8, is_blocking=False)
+            self._maps.append(memory.base)  # the pyopencl MemoryMap
+            for name, dtype, shape in self._layout():
+                rows = num_triangles if name == "triangles" else num_vertices
+                start = self._offsets[name]
+                host[name] = memory[start:start + rows * dtype.itemsize * math.prod(shape)].view(dtype) \
+                    .reshape(rows, *shape)
+            self.read_back_wait_ms = wait_ms([event])
+            return host
         for name, dtype, shape in self._layout():
             rows = num_triangles if name == "triangles" else num_vertices
             buffer, capacity = self._buffers[name]
@@ -876,7 +953,7 @@ class OutputBuffers:
                     else np.empty((rows, *shape), dtype)
                 events.append(cl.enqueue_copy(self.queue, target, buffer, is_blocking=False))
                 host[name] = target
-        cl.wait_for_events(events) if events else None
+        self.read_back_wait_ms = wait_ms(events) if events else 0.0
         return host
 
     def unmap(self) -> None:
@@ -900,6 +977,8 @@ class OutputBuffers:
 
     @property
     def nbytes(self) -> int:
+        if self._parent is not None:
+            return self._parent.size
         return sum(buffer.size for buffer, _ in self._buffers.values())
 
 
@@ -946,6 +1025,7 @@ class Plan:
     _host: dict = field(default_factory=dict)
     strip_offsets: cl_array.Array | None = None  # strip patterns' (P+1,) strip index offsets
     num_strip_indices: int = 0
+    wait_ms: float = 0.0  # host ms blocked waiting for stages 1-3's totals (wall_ms["waits"])
 
     def output_factors(self, first: int, last: int) -> tuple[np.ndarray, np.ndarray | None]:
         """(factors (n, 4) int32: each edge's segments, real_factors (n, 4) float32 or None when
