@@ -100,7 +100,7 @@ def child(args) -> dict:
 def run_child(argv: list[str], tree: Path | None) -> dict:
     env = dict(os.environ)
     if tree is not None:
-        env["PYTHONPATH"] = str(tree)
+        env["PYTHONPATH"] = os.pathsep.join(filter(None, (str(tree), env.get("PYTHONPATH"))))  # its cltess first
     done = subprocess.run([sys.executable, __file__, "--child", *argv], env=env, capture_output=True, text=True)
     if done.returncode:
         sys.exit(done.stderr)

@@ -43,7 +43,7 @@ case $which in
     run frame_loop_frames 200 python3 bench/frame_loop.py --device nvidia --frames-only --scenes $scenes --grid-copies 1 10 --json "$out/frame_loop_frames.json"
     run frame15_tests 150 env CLTESS_DEVICE=nvidia python3 -m pytest -q -p no:cacheprovider tests/test_frame_host.py tests/test_session.py tests/test_fused_offsets.py
     if [ -n "${3:-}" ]; then
-      run frame_loop_frames_base 200 env PYTHONPATH="$3" python3 bench/frame_loop.py --device nvidia --frames-only --scenes $scenes --grid-copies 1 10 --json "$out/frame_loop_frames_base.json"
+      run frame_loop_frames_base 200 env PYTHONPATH="$3:$PYTHONPATH" python3 bench/frame_loop.py --device nvidia --frames-only --scenes $scenes --grid-copies 1 10 --json "$out/frame_loop_frames_base.json"
       run frame_host 240 python3 bench/frame_host.py --device nvidia --frames 20 --repeat 2 --scenes $scenes --baseline "$3" --json "$out/frame_host.json"
     fi ;;
 esac
