@@ -82,6 +82,9 @@ class Session:
         device (``.device``); host arrays on first use, valid until the next call."""
         started = time.perf_counter()
         request = self.request_for(camera, **request_overrides)
+        if request.bound != "hull":  # its loop re-plans and emits on the host (Tessellator.plan)
+            raise ValueError(f"a Session tessellates per frame with the hull bound; bound={request.bound!r} "
+                             "is for Tessellator.plan / tessellate")
         tessellator = self.tessellator
         tessellator.compose(self.scene, request)  # found in the cache after the first frame
         key = request.sharp_edges

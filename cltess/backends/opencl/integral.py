@@ -118,10 +118,15 @@ def plan_integral(tessellator, scene, request, started: float):
             if not np.isfinite(worst).all():
                 raise RuntimeError(f"{scene.name}: the integral bound is not finite")
             failing = check & (worst > 1.0)
-            checked_at[check] = final[check]
+            passed = check & ~failing
+            checked_at[passed] = final[passed]  # certified while its final factors stay these
             if not failing.any():
                 break
-            trials[failing] += 1
+            tried = trial_factors(state["today"], trials)
+            for p in np.flatnonzero(failing):  # the next trial whose own factors differ
+                trials[p] += 1
+                while trials[p] < LAST_TRIAL and (trial_factors(state["today"][p:p + 1], trials[p:p + 1]) == tried[p]).all():
+                    trials[p] += 1
     stats.update(integral_patches=int(rational.sum()), integral_today=int(np.count_nonzero(rational & (trials == LAST_TRIAL))),
                  integral_ms=(time.perf_counter() - loop_started) * 1e3)
     plan.stats.update(stats)
