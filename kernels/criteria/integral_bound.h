@@ -49,44 +49,43 @@ inline float integral_lemma1_box(__global const float4 *pyramid, int levels, flo
     return (m.x * du * du + 2.0f * m.y * du * dv + m.z * dv * dv) / 8.0f;
 }
 
-/* One sub-triangle's part: corner i's term of the upper sum (corners q[3] of P, lam the max of
- * l_i over them). */
-inline float integral_corner_term(__global const float4 *pyramid, int levels, const float2 q[3], float2 x_i,
-                                  float lam, int t_count)
+/* One sub-triangle's part: corner x_i's term of the upper sum (q0, q1, q2 the corners of P, lam
+ * the max of l_i over them).  Plain variables, no private array: the Intel CPU compiler's
+ * vectoriser gave wrong, run-to-run different results with a float2 q[3] here. */
+inline float integral_corner_term(__global const float4 *pyramid, int levels, float2 q0, float2 q1, float2 q2,
+                                  float2 x_i, float lam, int t_count)
 {
-    float2 h = fmax(fmax(fabs(x_i - q[0]), fabs(x_i - q[1])), fabs(x_i - q[2]));
+    float2 h = fmax(fmax(fabs(x_i - q0), fabs(x_i - q1)), fabs(x_i - q2));
     float total = 0.0f;
     for (int s = 0; s < t_count; ++s) {
         float t0 = (float)s / (float)t_count, t1 = (float)(s + 1) / (float)t_count;
         float weight = (t1 - t0) - (t1 * t1 - t0 * t0) / 2.0f;  /* int_t0^t1 (1 - t) dt */
-        float2 lo = (float2)(INFINITY), hi = (float2)(-INFINITY);
-        for (int a = 0; a < 3; ++a) {
-            float2 p0 = (1.0f - t0) * q[a] + t0 * x_i, p1 = (1.0f - t1) * q[a] + t1 * x_i;
-            lo = fmin(lo, fmin(p0, p1));
-            hi = fmax(hi, fmax(p0, p1));
-        }
+        float2 a0 = (1.0f - t0) * q0 + t0 * x_i, a1 = (1.0f - t1) * q0 + t1 * x_i;
+        float2 b0 = (1.0f - t0) * q1 + t0 * x_i, b1 = (1.0f - t1) * q1 + t1 * x_i;
+        float2 c0 = (1.0f - t0) * q2 + t0 * x_i, c1 = (1.0f - t1) * q2 + t1 * x_i;
+        float2 lo = fmin(fmin(fmin(a0, a1), fmin(b0, b1)), fmin(c0, c1));
+        float2 hi = fmax(fmax(fmax(a0, a1), fmax(b0, b1)), fmax(c0, c1));
         float3 m = integral_query(pyramid, levels, lo, hi);
         total += lam * weight * (m.x * h.x * h.x + 2.0f * m.y * h.x * h.y + m.z * h.y * h.y);
     }
     return total;
 }
 
-inline float2 integral_sub_corner(int a, int b, int c, int k, float2 x0, float2 x1, float2 x2)
+inline float2 integral_sub_corner(int3 c, int k, float2 x0, float2 x1, float2 x2)
 {
-    return ((float)a * x0 + (float)b * x1 + (float)c * x2) / (float)k;
+    return ((float)c.x * x0 + (float)c.y * x1 + (float)c.z * x2) / (float)k;
 }
 
 inline float integral_sub_triangle(__global const float4 *pyramid, int levels, int3 c0, int3 c1, int3 c2, int k,
                                    float2 x0, float2 x1, float2 x2)
 {
-    float2 q[3] = {integral_sub_corner(c0.x, c0.y, c0.z, k, x0, x1, x2),
-                   integral_sub_corner(c1.x, c1.y, c1.z, k, x0, x1, x2),
-                   integral_sub_corner(c2.x, c2.y, c2.z, k, x0, x1, x2)};
+    float2 q0 = integral_sub_corner(c0, k, x0, x1, x2), q1 = integral_sub_corner(c1, k, x0, x1, x2);
+    float2 q2 = integral_sub_corner(c2, k, x0, x1, x2);
     int t_count = 4 * k / 3;
     int3 most = max(max(c0, c1), c2);
-    return integral_corner_term(pyramid, levels, q, x0, (float)most.x / (float)k, t_count)
-         + integral_corner_term(pyramid, levels, q, x1, (float)most.y / (float)k, t_count)
-         + integral_corner_term(pyramid, levels, q, x2, (float)most.z / (float)k, t_count);
+    return integral_corner_term(pyramid, levels, q0, q1, q2, x0, (float)most.x / (float)k, t_count)
+         + integral_corner_term(pyramid, levels, q0, q1, q2, x1, (float)most.y / (float)k, t_count)
+         + integral_corner_term(pyramid, levels, q0, q1, q2, x2, (float)most.z / (float)k, t_count);
 }
 
 /* The upper sum over K^2 sub-triangles (row i, then j; the upright one, then the inverted one):

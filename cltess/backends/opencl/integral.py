@@ -50,6 +50,29 @@ def integral_pyramids(tessellator, scene) -> tuple[cl_array.Array, cl_array.Arra
     return scene.prepared(("bezier", "integral pyramids", SUBPATCH_LEVELS, id(tessellator.context)), device)[1]
 
 
+def triangle_ratios(tessellator, pyramids, pyramid_of, check, uv, patch_ids, triangles, tolerances,
+                    subdivisions=SUBDIVISIONS, levels: int = SUBPATCH_LEVELS) -> np.ndarray:
+    """(T,) float32: ``stages/integral_bound.cl`` on triangles (T, 3) of vertices with uv (V, 2)
+    and patch_ids (V,): bound / tolerance of each triangle of a patch p with check[p] and a
+    pyramid (pyramid_of[p] >= 0), else 0.  pyramids, pyramid_of, tolerances: device arrays (or
+    host arrays, uploaded here); K = subdivisions[0], doubled up to subdivisions[-1]."""
+    queue = tessellator.queue
+    num = len(triangles)
+    if not num:
+        return np.zeros(0, np.float32)
+    device = [a if isinstance(a, cl_array.Array) else cl_array.to_device(queue, np.ascontiguousarray(a))
+              for a in (pyramids, np.asarray(pyramid_of, np.int32) if not isinstance(pyramid_of, cl_array.Array)
+                        else pyramid_of, np.asarray(check, np.int32), np.asarray(uv, np.float32),
+                        np.asarray(patch_ids, np.int32), np.asarray(triangles, np.uint32),
+                        tolerances if isinstance(tolerances, cl_array.Array) else np.asarray(tolerances, np.float32))]
+    ratios = cl_array.empty(queue, num, np.float32)
+    tessellator.programs.kernel("integral_bound")(
+        queue, (max(64, -(-num // 64) * 64),), None, *(a.data for a in device[:6]), np.uint32(num),
+        np.int32(levels), np.int32(pyramid_cells(levels)), np.int32(subdivisions[0]), np.int32(subdivisions[-1]),
+        device[6].data, ratios.data)
+    return ratios.get()
+
+
 def plan_integral(tessellator, scene, request, started: float):
     """The integral-bound loop (module docstring); returns the final Plan, whose stats carry
     "integral_rounds", "integral_checked" (triangle bounds evaluated), "integral_today"
@@ -88,7 +111,6 @@ def plan_integral(tessellator, scene, request, started: float):
         pixels = request.tolerance.pixels if isinstance(request.tolerance, ScreenSpace) else None
         tolerances = cl_array.to_device(tessellator.queue, scene_tolerances(scene, eps, pixels, request.sharp_edges)
                                         .astype(np.float32))
-        kernel = tessellator.programs.kernel("integral_bound")
         checked_at = np.full((count, 4), np.iinfo(np.int32).min, np.int32)
         while True:
             state["trials"] = trials
@@ -101,16 +123,9 @@ def plan_integral(tessellator, scene, request, started: float):
             tess = tessellator.emit(plan, 0, plan.num_patches)
             triangles = np.ascontiguousarray(tess.triangles, np.uint32)
             num = len(triangles)
-            ratios = np.zeros(num, np.float32)
+            ratios = triangle_ratios(tessellator, pyramids, pyramid_of_device, check, tess.uv, tess.patch_ids,
+                                     triangles, tolerances)
             if num:
-                ratios_device = cl_array.empty(tessellator.queue, num, np.float32)
-                arrays = [cl_array.to_device(tessellator.queue, np.ascontiguousarray(a)) for a in
-                          (check.astype(np.int32), tess.uv, tess.patch_ids, triangles)]
-                kernel(tessellator.queue, (max(64, -(-num // 64) * 64),), None, pyramids.data, pyramid_of_device.data,
-                       *(a.data for a in arrays), np.uint32(num), np.int32(SUBPATCH_LEVELS),
-                       np.int32(pyramid_cells(SUBPATCH_LEVELS)), np.int32(SUBDIVISIONS[0]),
-                       np.int32(SUBDIVISIONS[-1]), tolerances.data, ratios_device.data)
-                ratios = ratios_device.get()
                 stats["integral_checked"] += int(np.count_nonzero(check[tess.patch_ids[triangles[:, 0]]]))
             worst = np.zeros(count, np.float32)
             if num:
