@@ -30,6 +30,11 @@ from ...criteria.tolerance import ObjectSpace, ScreenSpace
 from ...kinds import BEZIER, FLAG_CULLED, FLAG_SATURATED
 
 LAST_TRIAL = len(TRIAL_SCALES) - 1
+#: A failed patch's next scale is at least its scale times (worst bound / tolerance)^JUMP_POWER:
+#: 0.5 would be the scale a bound quadratic in the step asks for; the integral form falls faster
+#: than that where the curvature is a spike (smaller boxes see smaller majorants), so less
+#: (bench/bound_integral.py measured 0.25).
+JUMP_POWER = 0.25
 
 
 def integral_pyramids(tessellator, scene) -> tuple[cl_array.Array, cl_array.Array, np.ndarray]:
@@ -51,25 +56,33 @@ def integral_pyramids(tessellator, scene) -> tuple[cl_array.Array, cl_array.Arra
 
 
 def triangle_ratios(tessellator, pyramids, pyramid_of, check, uv, patch_ids, triangles, tolerances,
-                    subdivisions=SUBDIVISIONS, levels: int = SUBPATCH_LEVELS) -> np.ndarray:
+                    subdivisions=SUBDIVISIONS, levels: int = SUBPATCH_LEVELS, skip_failed: bool = False,
+                    worst_of_patch: bool = False):
     """(T,) float32: ``stages/integral_bound.cl`` on triangles (T, 3) of vertices with uv (V, 2)
     and patch_ids (V,): bound / tolerance of each triangle of a patch p with check[p] and a
     pyramid (pyramid_of[p] >= 0), else 0.  pyramids, pyramid_of, tolerances: device arrays (or
-    host arrays, uploaded here); K = subdivisions[0], doubled up to subdivisions[-1]."""
+    host arrays, uploaded here); K = subdivisions[0], doubled up to subdivisions[-1].
+    skip_failed: a patch's triangles stop being evaluated once one is over 1 (their ratio then
+    reads 0).  worst_of_patch: return (ratios, (P,) worst ratio of each patch's evaluated ones)."""
     queue = tessellator.queue
     num = len(triangles)
+    patches = len(check)
     if not num:
-        return np.zeros(0, np.float32)
+        empty = np.zeros(0, np.float32)
+        return (empty, np.zeros(patches, np.float32)) if worst_of_patch else empty
     device = [a if isinstance(a, cl_array.Array) else cl_array.to_device(queue, np.ascontiguousarray(a))
               for a in (pyramids, np.asarray(pyramid_of, np.int32) if not isinstance(pyramid_of, cl_array.Array)
                         else pyramid_of, np.asarray(check, np.int32), np.asarray(uv, np.float32),
                         np.asarray(patch_ids, np.int32), np.asarray(triangles, np.uint32),
                         tolerances if isinstance(tolerances, cl_array.Array) else np.asarray(tolerances, np.float32))]
     ratios = cl_array.empty(queue, num, np.float32)
+    worst = cl_array.to_device(queue, np.zeros(patches, np.int32))
     tessellator.programs.kernel("integral_bound")(
         queue, (max(64, -(-num // 64) * 64),), None, *(a.data for a in device[:6]), np.uint32(num),
         np.int32(levels), np.int32(pyramid_cells(levels)), np.int32(subdivisions[0]), np.int32(subdivisions[-1]),
-        device[6].data, ratios.data)
+        device[6].data, ratios.data, worst.data, np.int32(skip_failed))
+    if worst_of_patch:
+        return ratios.get(), worst.get().view(np.float32)
     return ratios.get()
 
 
@@ -123,13 +136,10 @@ def plan_integral(tessellator, scene, request, started: float):
             tess = tessellator.emit(plan, 0, plan.num_patches)
             triangles = np.ascontiguousarray(tess.triangles, np.uint32)
             num = len(triangles)
-            ratios = triangle_ratios(tessellator, pyramids, pyramid_of_device, check, tess.uv, tess.patch_ids,
-                                     triangles, tolerances)
-            if num:
-                stats["integral_checked"] += int(np.count_nonzero(check[tess.patch_ids[triangles[:, 0]]]))
-            worst = np.zeros(count, np.float32)
-            if num:
-                np.maximum.at(worst, tess.patch_ids[triangles[:, 0]], ratios)
+            ratios, worst = triangle_ratios(tessellator, pyramids, pyramid_of_device, check, tess.uv,
+                                            tess.patch_ids, triangles, tolerances, skip_failed=True,
+                                            worst_of_patch=True)
+            stats["integral_checked"] += int(np.count_nonzero(ratios))
             if not np.isfinite(worst).all():
                 raise RuntimeError(f"{scene.name}: the integral bound is not finite")
             failing = check & (worst > 1.0)
@@ -138,9 +148,14 @@ def plan_integral(tessellator, scene, request, started: float):
             if not failing.any():
                 break
             tried = trial_factors(state["today"], trials)
-            for p in np.flatnonzero(failing):  # the next trial whose own factors differ
+            for p in np.flatnonzero(failing):
+                # The next trial whose own factors differ, and at least JUMP_POWER of the way to
+                # where a bound quadratic in the step would pass (bound ~ 1/scale^2).
+                target = TRIAL_SCALES[trials[p]] * float(worst[p]) ** JUMP_POWER
                 trials[p] += 1
-                while trials[p] < LAST_TRIAL and (trial_factors(state["today"][p:p + 1], trials[p:p + 1]) == tried[p]).all():
+                while trials[p] < LAST_TRIAL and (
+                        TRIAL_SCALES[trials[p]] < target
+                        or (trial_factors(state["today"][p:p + 1], trials[p:p + 1]) == tried[p]).all()):
                     trials[p] += 1
     stats.update(integral_patches=int(rational.sum()), integral_today=int(np.count_nonzero(rational & (trials == LAST_TRIAL))),
                  integral_ms=(time.perf_counter() - loop_started) * 1e3)
