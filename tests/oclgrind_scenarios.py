@@ -317,6 +317,15 @@ def esc_levels_strips():
     return teapot([0, 4, 8, 12, 16, 20, 21, 24]), dict(eps=0.1, pattern="esc")
 
 
+def integral_bound():
+    """Two rational patches (weights 0.4 to 2.5) under Request(bound="integral"): the trials, the
+    integral_bound kernel (Lemma 1 on a box, the upper sums, the per-patch early stop) on every
+    emitted triangle, transition triangles included, then the final emission."""
+    rng = np.random.default_rng(3)
+    weights = rng.uniform(0.4, 2.5, (4, 7))
+    return height_grid(bumps(2, 1, [[0.3, 1.2]]), weights, name="rational pair"), dict(eps=0.8, bound="integral")
+
+
 SCENARIOS = {
     "uniform": uniform,
     "one_transition": one_transition,
@@ -347,6 +356,7 @@ SCENARIOS = {
     "esc": esc,
     "esc_collapsed_lid_screen": esc_collapsed_lid_screen,
     "esc_levels_strips": esc_levels_strips,
+    "integral_bound": integral_bound,
 }
 
 #: Scenarios whose tessellation is then measured on the device (Tessellator.verify,
