@@ -195,7 +195,7 @@ def lemma1_box(pyramid: np.ndarray, levels: int, corners: np.ndarray) -> float:
     corners = corners.astype(np.float32)
     lo, hi = corners.min(axis=0), corners.max(axis=0)
     m = pyramid_query(pyramid, levels, lo, hi).astype(np.float32)
-    du, dv = hi - lo
+    du, dv = hi - lo + np.float32(2) * np.float32(BOX_WIDENING)
     return float((m[0] * du * du + np.float32(2) * m[1] * du * dv + m[2] * dv * dv) / np.float32(8))
 
 
@@ -213,7 +213,7 @@ def upper_sum(pyramid: np.ndarray, levels: int, corners: np.ndarray, k: int) -> 
         for i in range(3):
             lam = f32(sub[:, i].max()) / f32(k)
             x_i = corners[i]
-            h = np.abs(x_i - q).max(axis=0)
+            h = np.abs(x_i - q).max(axis=0) + np.float32(BOX_WIDENING)  # the float32 corners' rounding
             for s in range(t_count):
                 t0, t1 = f32(s) / f32(t_count), f32(s + 1) / f32(t_count)
                 weight = (t1 - t0) - (t1 * t1 - t0 * t0) / f32(2)

@@ -45,7 +45,7 @@ inline float integral_lemma1_box(__global const float4 *pyramid, int levels, flo
 {
     float2 lo = fmin(fmin(x0, x1), x2), hi = fmax(fmax(x0, x1), x2);
     float3 m = integral_query(pyramid, levels, lo, hi);
-    float du = hi.x - lo.x, dv = hi.y - lo.y;
+    float du = hi.x - lo.x + 2.0f * INTEGRAL_BOX_WIDENING, dv = hi.y - lo.y + 2.0f * INTEGRAL_BOX_WIDENING;
     return (m.x * du * du + 2.0f * m.y * du * dv + m.z * dv * dv) / 8.0f;
 }
 
@@ -55,7 +55,8 @@ inline float integral_lemma1_box(__global const float4 *pyramid, int levels, flo
 inline float integral_corner_term(__global const float4 *pyramid, int levels, float2 q0, float2 q1, float2 q2,
                                   float2 x_i, float lam, int t_count)
 {
-    float2 h = fmax(fmax(fabs(x_i - q0), fabs(x_i - q1)), fabs(x_i - q2));
+    /* |h_i| at P's corners, plus the widening: the float32 corners q_a are within a few ulp of P's */
+    float2 h = fmax(fmax(fabs(x_i - q0), fabs(x_i - q1)), fabs(x_i - q2)) + INTEGRAL_BOX_WIDENING;
     float total = 0.0f;
     for (int s = 0; s < t_count; ++s) {
         float t0 = (float)s / (float)t_count, t1 = (float)(s + 1) / (float)t_count;
