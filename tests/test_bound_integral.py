@@ -202,6 +202,14 @@ def test_request_and_cli_refuse_what_the_option_cannot_do(tmp_path):
         Request.of(eps=1.0, bound="exact")
     with pytest.raises(ValueError, match="cannot be used with pattern"):
         Request.of(eps=1.0, bound="integral", pattern="semi_uniform")
+    from cltess.backends.numpy import NumpyBackend
+    from cltess.session import Session
+
+    scene = load_scene(SCENES / "torus.bpt")
+    with pytest.raises(ValueError, match="OpenCL backend"):
+        NumpyBackend().plan(scene, Request.of(eps=1.0, bound="integral"))
+    with pytest.raises(ValueError, match="Session"):
+        Session(scene, eps=1.0, bound="integral").tessellate()
     run = subprocess.run([sys.executable, "-m", "cltess", "tessellate", str(SCENES / "torus.bpt"), "--eps", "0.1",
                           "--bound", "integral", "--pattern", "semi-uniform", "-o", str(tmp_path / "t.ply")],
                          capture_output=True, text=True)
