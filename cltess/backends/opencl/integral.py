@@ -137,8 +137,8 @@ def plan_integral(tessellator, scene, request, started: float):
             triangles = np.ascontiguousarray(tess.triangles, np.uint32)
             num = len(triangles)
             ratios, worst = triangle_ratios(tessellator, pyramids, pyramid_of_device, check, tess.uv,
-                                            tess.patch_ids, triangles, tolerances, skip_failed=True,
-                                            worst_of_patch=True)
+                                            tess.patch_ids, triangles, tolerances, levels=SUBPATCH_LEVELS,
+                                            skip_failed=True, worst_of_patch=True)
             stats["integral_checked"] += int(np.count_nonzero(ratios))
             if not np.isfinite(worst).all():
                 raise RuntimeError(f"{scene.name}: the integral bound is not finite")
