@@ -9,7 +9,7 @@ scene, the best of ``--repeat`` runs after one untimed warm-up (which builds the
 "integral", the scene's majorant tables); "tables" is the wall time of making those tables once
 (host, float64), which a scene pays on its first integral call only.
 
-    python bench/bound_integral.py [--device pocl] [--repeat 3] [--json out.json]
+    python bench/bound_integral.py [--device pocl] [--repeat 3] [--json out.json] [--subpatch-levels 7]
 """
 from __future__ import annotations
 
@@ -47,7 +47,12 @@ def main(argv=None) -> None:
     parser.add_argument("--scenes", nargs="+", default=["random", "torus", "sphere"])
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--json", type=Path)
+    parser.add_argument("--subpatch-levels", type=int,
+                        help="2^this subpatches per side of the majorant tables (default: the engine's, 6)")
     args = parser.parse_args(argv)
+    if args.subpatch_levels is not None:  # an experiment: the engine's constant, for this process
+        import cltess.backends.opencl.integral as engine
+        engine.SUBPATCH_LEVELS = args.subpatch_levels
 
     from cltess.backends.opencl.integral import integral_pyramids
     from cltess.pipeline import Tessellator
