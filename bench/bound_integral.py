@@ -79,7 +79,7 @@ def main(argv=None) -> None:
             print(f"| {name} ({len(patches)}) | {rel:g} | {hull['triangles']:,} | {hull['ratio']:.3f} | "
                   f"{tight['triangles']:,} | {tight['ratio']:.3f} | {tight['triangles'] / hull['triangles']:.2f} | "
                   f"{hull['seconds'] * 1e3:.1f} | {tight['seconds'] * 1e3:.1f} | {tight['integral_rounds']} | "
-                  f"{tight['integral_today']} of {tight['integral_patches']} |", flush=True)
+                  f"{tight['integral_at_hull']} of {tight['integral_patches']} |", flush=True)
         results["scenes"][name] = {"diagonal": size, "tables_seconds": tables, "runs": rows}
         print(f"| {name}: majorant tables | | | | | | | | {tables * 1e3:.0f} (once per scene) | | |", flush=True)
     if args.json:

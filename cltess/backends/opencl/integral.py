@@ -88,7 +88,7 @@ def triangle_ratios(tessellator, pyramids, pyramid_of, check, uv, patch_ids, tri
 
 def plan_integral(tessellator, scene, request, started: float):
     """The integral-bound loop (module docstring); returns the final Plan, whose stats carry
-    "integral_rounds", "integral_checked" (triangle bounds evaluated), "integral_today"
+    "integral_rounds", "integral_checked" (triangle bounds evaluated), "integral_at_hull"
     (rational patches left at today's factors), "integral_patches" (rational patches) and
     "integral_ms" (host wall time of the loop beyond the first plan)."""
     from ...bound import scene_tolerances
@@ -157,7 +157,7 @@ def plan_integral(tessellator, scene, request, started: float):
                         TRIAL_SCALES[trials[p]] < target
                         or (trial_factors(state["today"][p:p + 1], trials[p:p + 1]) == tried[p]).all()):
                     trials[p] += 1
-    stats.update(integral_patches=int(rational.sum()), integral_today=int(np.count_nonzero(rational & (trials == LAST_TRIAL))),
+    stats.update(integral_patches=int(rational.sum()), integral_at_hull=int(np.count_nonzero(rational & (trials == LAST_TRIAL))),
                  integral_ms=(time.perf_counter() - loop_started) * 1e3)
     plan.stats.update(stats)
     plan.integral_trials = trials
