@@ -92,14 +92,14 @@ def measured_deviation(patches, positions, uv, patch_of_triangle, triangles, ord
 
 # --- cltess ---------------------------------------------------------------------------------------
 
-def run_cltess(patches: np.ndarray, eps: float) -> dict:
+def run_cltess(patches: np.ndarray, eps: float, bound: str = "hull") -> dict:
     from cltess.pipeline import Tessellator
     from cltess.scene import Scene
 
     tessellator = run_cltess.__dict__.setdefault("tessellator", Tessellator())
     scene = Scene(patches, np.zeros(len(patches), np.int32), name="bench")
     start = time.perf_counter()
-    tess = tessellator.tessellate(scene, eps=eps, max_factor=4096)
+    tess = tessellator.tessellate(scene, eps=eps, max_factor=4096, bound=bound)
     seconds = time.perf_counter() - start
     tris = tess.triangles.astype(np.int64)
     deviation = measured_deviation(patches, tess.positions, tess.uv, tess.patch_ids[tris[:, 0]], tris)
@@ -201,6 +201,8 @@ def main(argv=None) -> None:
     parser.add_argument("--no-occ", action="store_true", help="cltess only (e.g. to compare two versions)")
     parser.add_argument("--baseline", type=Path, help="a --json of another cltess version: its rows too")
     parser.add_argument("--baseline-label", default="baseline")
+    parser.add_argument("--bound", choices=("hull", "integral"), default="hull",
+                        help="cltess's Request.bound (integral: docs/rational-bound.md)")
     args = parser.parse_args(argv)
     baseline = json.loads(args.baseline.read_text()) if args.baseline else None
 
@@ -210,7 +212,7 @@ def main(argv=None) -> None:
     for name in args.scenes:
         patches = load_patches(name)
         size = diagonal(patches)
-        runs = {"diagonal": size, "cltess": [run_cltess(patches, e * size) for e in RELATIVE_EPS], "occ": []}
+        runs = {"diagonal": size, "cltess": [run_cltess(patches, e * size, args.bound) for e in RELATIVE_EPS], "occ": []}
         rows = runs["cltess"] + (baseline["scenes"].get(name, {}).get("cltess", []) if baseline else [])
         target = min(r["deviation"] for r in rows)
         for angle in ANGLES if not args.no_occ else []:

@@ -17,6 +17,9 @@ from .patterns.semi_uniform import DEFAULT_MAX_LEVEL
 
 #: The largest max_level: 2^level within the kernels' factor limit (cltess.limits.MAX_FACTOR).
 MAX_LEVEL = MAX_FACTOR.bit_length() - 1
+#: Request.bound's values: the hull bound's factors (docs/rational-bound.md), or tighter ones for
+#: rational Bézier patches certified triangle by triangle by the integral form of the remainder.
+BOUNDS = ("hull", "integral")
 #: Request.emit's values: stages 4-5 per patch, or by level (cltess/backends/opencl/levels.py).
 EMIT_MODES = ("per_patch", "by_level")
 from .scene import Camera, Scene
@@ -50,6 +53,9 @@ class Request:
     depth_map:      "linear" (g1) or "quadratic" (g2) for "depth".
     depth_range:    (near, far) depths mapped onto (high, low); None: this frame's range.
     camera:         the camera of "depth" and "silhouette" (None: the scene's).
+    bound:          "hull" (stage 1's factors) or "integral": rational Bézier patches try smaller
+                    factors, each emitted triangle bounded by the integral form of the remainder
+                    (cltess/backends/opencl/integral.py; OpenCL backend, integer patterns only).
     """
 
     tolerance: ObjectSpace | ScreenSpace
@@ -64,6 +70,7 @@ class Request:
     depth_map: str = "linear"
     depth_range: tuple | None = None
     camera: Camera | None = None
+    bound: str = "hull"
 
     def __post_init__(self):
         value = self.tolerance.eps if isinstance(self.tolerance, ObjectSpace) else self.tolerance.pixels
@@ -97,6 +104,11 @@ class Request:
                                                    for x in self.depth_range)
                 and self.depth_range[0] < self.depth_range[1]):
             raise ValueError(f"depth_range must be (near, far) with near < far, got {self.depth_range!r}")
+        if self.bound not in BOUNDS:
+            raise ValueError(f"bound must be one of {', '.join(BOUNDS)}, got {self.bound!r}")
+        if self.bound == "integral" and (self.level_function is not None or self.pattern not in (None, "transition", "quad_transition")):
+            raise ValueError(f"bound 'integral' scales the transition pattern's factors; it cannot be used with "
+                             f"pattern {self.pattern or 'sd2'!r}")
         if self.camera is not None and not isinstance(self.camera, Camera):
             raise ValueError(f"camera must be a cltess.scene.Camera, got {type(self.camera).__name__}")
 

@@ -96,6 +96,9 @@ class Session:
         next frame waits for this one's stages anyway (its stages 1-3 read back two totals)."""
         started = time.perf_counter()
         request = self.request_for(camera, **request_overrides)
+        if request.bound != "hull":  # its loop re-plans and emits on the host (Tessellator.plan)
+            raise ValueError(f"a Session tessellates per frame with the hull bound; bound={request.bound!r} "
+                             "is for Tessellator.plan / tessellate")
         tessellator = self.tessellator
         # A new camera alone needs the programs of the last frame (they depend on the tolerance's
         # kind, not its camera); anything else is looked up (compose: found in the cache).

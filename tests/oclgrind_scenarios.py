@@ -326,6 +326,15 @@ def esc_sphere_poles():
     return scene, dict(eps=0.05, pattern="esc")
 
 
+def integral_bound():
+    """Two rational patches (weights 0.4 to 2.5) under Request(bound="integral"): the trials, the
+    integral_bound kernel (Lemma 1 on a box, the upper sums, the per-patch early stop) on every
+    emitted triangle, transition triangles included, then the final emission."""
+    rng = np.random.default_rng(3)
+    weights = rng.uniform(0.4, 2.5, (4, 7))
+    return height_grid(bumps(2, 1, [[0.3, 1.2]]), weights, name="rational pair"), dict(eps=0.8, bound="integral")
+
+
 SCENARIOS = {
     "uniform": uniform,
     "one_transition": one_transition,
@@ -357,6 +366,7 @@ SCENARIOS = {
     "esc_collapsed_lid_screen": esc_collapsed_lid_screen,
     "esc_levels_strips": esc_levels_strips,
     "esc_sphere_poles": esc_sphere_poles,
+    "integral_bound": integral_bound,
 }
 
 #: Scenarios whose tessellation is then measured on the device (Tessellator.verify,

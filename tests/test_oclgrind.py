@@ -237,6 +237,10 @@ def test_scenarios_reach_every_code_path(oclgrind, tmp_path_factory):
     for name in ("collapsed_lid", "collapsed_bottom_direct", "esc_sphere_poles"):
         scene, _ = scenarios.SCENARIOS[name]()
         assert edge_groups(scene.patches).collapsed > 0, name
+    integral = stats["integral_bound"]  # stages/integral_bound.cl ran, and a trial was taken back
+    ring = factors["integral_bound"]
+    assert integral["integral_rounds"] >= 2 and integral["integral_checked"] > 0
+    assert ((ring[:, 0] != ring[:, 2]) | (ring[:, 1] != ring[:, 3])).any(), "integral: transition triangles"
     for name in scenarios.VERIFIED:  # stages/verify.cl ran, and measured something
         assert 0.0 < run.results[name]["verify_ratio"] < 1.0, name
 

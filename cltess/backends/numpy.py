@@ -151,6 +151,9 @@ class NumpyBackend:
 
     def plan(self, scene: Scene, request: Request) -> NumpyPlan:
         request.check(scene)
+        if request.bound != "hull":  # its loop needs stages 2-5 and the kernel per round
+            raise ValueError(f"bound={request.bound!r} runs on the OpenCL backend (cltess.Tessellator), "
+                             "not the NumPy reference")
         parts, inputs, factors, flags, base = [], [], [], [], 0
         for kind in KINDS:
             count = kind.count(scene)

@@ -248,6 +248,9 @@ class Tessellator:
         request.check(scene)
         started = time.perf_counter()
         self.compose(scene, request)
+        if request.bound == "integral":  # tighter factors, certified triangle by triangle
+            from .integral import plan_integral
+            return plan_integral(self, scene, request, started)
         return self.plan_on(self.scene_data(scene, request.sharp_edges), request, started)
 
     def compose(self, scene: Scene, request: Request) -> None:
@@ -267,6 +270,8 @@ class Tessellator:
                     build_level_function_programs(self)
                 if pattern.primitive == "strips":
                     build_strip_programs(self, pattern)
+        if request.bound == "integral":
+            self.programs.kernel("integral_bound")
 
     def scene_data(self, scene: Scene, sharp_edges: str = "straight") -> "SceneData":
         """What stays on the device for a scene whatever the tolerance or camera: every kind's
@@ -293,11 +298,12 @@ class Tessellator:
         return SceneData(scene, sharp_edges, base, parts, objects, self.upload_groups(groups, base), stats)
 
     def plan_on(self, data: "SceneData", request: Request, started: float | None = None,
-                scratch: dict | None = None) -> "Plan":
+                scratch: dict | None = None, stage1_hook=None) -> "Plan":
         """Stages 1-3 on a scene's device data (``scene_data``) for a request (its programs
         built: ``compose``).  scratch: a dict in which the per-patch arrays (factors, flags,
         counts, offsets) are kept and reused from call to call (a ``Session``'s), so that a
-        new plan overwrites the last one's; else fresh arrays."""
+        new plan overwrites the last one's; else fresh arrays.  stage1_hook(factors, flags):
+        called after stage 1, before stage 2, may rewrite the factors (integral.py's trials)."""
         started = time.perf_counter() if started is None else started
         scene, count = data.scene, data.num_patches
         tolerance = request.tolerance_for(scene)
@@ -316,6 +322,8 @@ class Tessellator:
             if part.pattern.fixed_point:
                 level_events, level_stats = level_factors(self, scene, request, part, factors)
                 events["factors"] += level_events
+        if stage1_hook is not None:
+            stage1_hook(factors, flags)
         crack = next((p.pattern.crack for p in parts if p.pattern.crack != "crack/max.h"), "crack/max.h")
         final, events["crack_free"] = self.stage_crack_free(factors, data.groups, crack, out=scratch.get("final"))
         scratch["final"] = final

@@ -1,0 +1,249 @@
+"""The integral form of the interpolation remainder as a per-triangle bound (issue 9:
+docs/rational-bound.md, "The integral-form bound in the engine").  NumPy mirror of
+``kernels/criteria/integral_bound.h`` and the host half of ``Request(bound="integral")``.
+
+For a triangle T with corners x_i, barycentric coordinates l_i(x) and h_i = x_i - x,
+
+    |p(x) - l(x)| <= sum_i l_i(x) int_0^1 (1 - t) |D^2 p(x + t h_i)[h_i, h_i]| dt,
+
+and |D^2 p(xi)[h, h]| <= m_uu h_u^2 + 2 m_uv |h_u h_v| + m_vv h_v^2 with m_ab the hull bound
+(Lemma 2) of the S x S subpatches meeting a box around xi.  Upper sums over K^2 sub-triangles
+and [0, 1] cut in T intervals turn it into a number per triangle; every step is an inequality.
+
+The host part: ``subpatch_majorants`` (float64 de Casteljau subdivision of the (9, 9) nets by
+subdivision matrices, then max_k |N_ab,k| / W_k per subpatch) and ``majorant_pyramid`` (max
+pooled to every coarser level, rounded up to float32 with a safety factor); the device part,
+mirrored here: ``pyramid_query`` (max over the cells a box meets) and ``triangle_bounds``.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .zheng_sederberg import CUBIC_DERIVATIVE, _bernstein_product
+
+#: S = 2^SUBPATCH_LEVELS subpatches per side (64: docs/rational-bound.md, measured).
+SUBPATCH_LEVELS = 6
+#: Sub-triangles per side of the upper sums tried in turn (t intervals: T = 4 K / 3); a triangle
+#: that passes Lemma 1 with its box's majorant skips them (kernels/criteria/integral_bound.h).
+SUBDIVISIONS = (6, 12, 24)
+#: The majorant table is float64 on the host, stored float32 rounded up and multiplied by this
+#: (covers the float64 subdivision's rounding, relative ~1e-14, with room).
+TABLE_SAFETY = 1.0 + 1e-6
+#: The float32 kernel sums at most 3 * 24^2 * 32 non-negative terms of relative error a few
+#: ulp each, and compares bound * BOUND_SAFETY with the tolerance (relative 1e-4 >> 1e-7 * 10).
+BOUND_SAFETY = 1.0 + 1e-4
+#: Boxes are widened by this (domain units, [0, 1]) before they are rounded to cells, so that a
+#: float32 rounding of a corner cannot drop a subpatch the true box meets (ulp of 1.0: 1.2e-7).
+BOX_WIDENING = 1e-6
+#: A box query looks at no more than this many cells per side; a larger box is looked up on a
+#: coarser level of the pyramid (each level halves).
+QUERY_SPAN = 4
+#: The trial scales of today's factors (stage 1's (m, n)), in the order a patch tries them
+#: (factors only rise); the last one is today's bound itself (Lemmas 1/3: always certified).
+#: (0.78, 0.92, 0.96 added to a first list of ten: on the random patches 4% fewer triangles at
+#: eps = 1e-2 of the diagonal, 0.7% at 1e-3, one to three more rounds.)
+TRIAL_SCALES = (0.2, 0.25, 0.3, 0.35, 0.42, 0.5, 0.6, 0.7, 0.78, 0.85, 0.92, 0.96, 1.0)
+
+
+def numerator_nets(patch: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """((10, 10, 3, 3) N_ab nets [j, i, which (uu, uv, vv), xyz], (10, 10) net of w^3), plain
+    Bernstein basis (docs/rational-bound.md, Lemma 2; zheng_sederberg.second_derivative_hull
+    before its division).  X is centred first (the N_ab are translation-invariant)."""
+    patch = np.asarray(patch, float)
+    w = patch[..., 3:]
+    points = patch[..., :3] / w
+    centre = (points.min(axis=(0, 1)) + points.max(axis=(0, 1))) / 2
+    h = np.concatenate([patch[..., :3] - w * centre, w], axis=-1)
+    d_u = lambda a: np.einsum("ki,jic->jkc", CUBIC_DERIVATIVE, a)  # noqa: E731
+    d_v = lambda a: np.einsum("kj,jic->kic", CUBIC_DERIVATIVE, a)  # noqa: E731
+    h_u, h_v = d_u(h), d_v(h)
+
+    def wedge(a, b):  # w_a X_b - w_b X_a, degree (6, 6)
+        return _bernstein_product(a[..., 3:], b[..., :3]) - _bernstein_product(b[..., 3:], a[..., :3])
+
+    def scaled(a, b):
+        return _bernstein_product(a[..., 3:], b)
+
+    b_u, b_v = wedge(h, h_u), wedge(h, h_v)
+    numerators = (scaled(h, wedge(h, d_u(h_u))) - 2 * scaled(h_u, b_u),
+                  scaled(h, wedge(h, d_v(h_u))) - scaled(h_u, b_v) - scaled(h_v, b_u),
+                  scaled(h, wedge(h, d_v(h_v))) - 2 * scaled(h_v, b_v))
+    return np.stack(numerators, axis=2), scaled(h, scaled(h, h[..., 3:]))[..., 0]
+
+
+def subdivision_matrices(pieces: int, degree: int = 9) -> np.ndarray:
+    """(pieces, degree + 1, degree + 1): M[s] maps a degree-``degree`` Bernstein net on [0, 1]
+    to the net of its restriction to [s / pieces, (s + 1) / pieces] (de Casteljau: right part
+    at a, then left part at (b - a) / (1 - a); float64)."""
+    out = np.empty((pieces, degree + 1, degree + 1))
+    for s in range(pieces):
+        a, b = s / pieces, (s + 1) / pieces
+        c = np.eye(degree + 1)  # columns: the unit nets
+        if a > 0:  # right part at a: points c^(degree - r)_r
+            rows, level = [c[-1]], c
+            for _ in range(degree):
+                level = (1 - a) * level[:-1] + a * level[1:]
+                rows.append(level[-1])
+            c = np.array(rows[::-1])
+        t = (b - a) / (1 - a)
+        if t < 1:
+            rows, level = [c[0]], c
+            for _ in range(degree):
+                level = (1 - t) * level[:-1] + t * level[1:]
+                rows.append(level[0])
+            c = np.array(rows)
+        out[s] = c
+    return out
+
+
+def subpatch_majorants(patch: np.ndarray, levels: int = SUBPATCH_LEVELS) -> np.ndarray:
+    """(S, S, 3) float64 [v piece, u piece, (uu, uv, vv)], S = 2^levels: max_k |N_ab,k| / W_k of
+    each subpatch's nets (Lemma 2 on the subpatch: |p_ab| <= that on it)."""
+    numerators, cube = numerator_nets(patch)
+    pieces = 1 << levels
+    nets = np.concatenate([numerators.reshape(10, 10, 9), cube[..., None]], axis=-1)  # [j, i, c]
+    matrices = subdivision_matrices(pieces)
+    along_u = np.einsum("sai,jic->sjac", matrices, nets)  # [u piece, j, i', c]
+    out = np.empty((pieces, pieces, 3))
+    for t in range(pieces):  # one v piece at a time: (S, 10, 10, 10) floats
+        sub = np.einsum("bj,sjac->sbac", matrices[t], along_u)  # [u piece, j', i', c]
+        weights = sub[..., 9]
+        if not (weights > 0).all():
+            raise ValueError("w^3 has a non-positive coefficient on a subpatch: weights must be > 0")
+        norms = np.linalg.norm(sub[..., :9].reshape(sub.shape[:3] + (3, 3)), axis=-1) / weights[..., None]
+        out[t] = norms.max(axis=(1, 2))
+    return out
+
+
+def pyramid_levels(levels: int = SUBPATCH_LEVELS) -> list[tuple[int, int]]:
+    """(offset, side) of each level of a patch's pyramid, finest (side S) first, then S/2 ... 1."""
+    out, offset = [], 0
+    for level in range(levels, -1, -1):
+        out.append((offset, 1 << level))
+        offset += 1 << (2 * level)
+    return out
+
+
+def pyramid_cells(levels: int = SUBPATCH_LEVELS) -> int:
+    """Cells of one patch's pyramid: S^2 + (S/2)^2 + ... + 1."""
+    return ((1 << (2 * levels + 2)) - 1) // 3
+
+
+def majorant_pyramid(majorants: np.ndarray) -> np.ndarray:
+    """(cells, 4) float32 of one patch: each level's (m_uu, m_uv, m_vv, 0) row by row (v, then u),
+    finest first, every coarser cell the max of its four children; rounded up (float32 towards
+    +inf, times TABLE_SAFETY) so the stored values bound the float64 ones."""
+    levels = int(round(math.log2(majorants.shape[0])))
+    rows, level = [], majorants
+    while True:
+        rows.append(level.reshape(-1, 3))
+        if level.shape[0] == 1:
+            break
+        level = np.maximum.reduce([level[0::2, 0::2], level[1::2, 0::2], level[0::2, 1::2], level[1::2, 1::2]])
+    values = np.concatenate(rows) * TABLE_SAFETY
+    stored = values.astype(np.float32)
+    low = stored.astype(float) < values
+    stored[low] = np.nextafter(stored[low], np.float32(np.inf))
+    out = np.zeros((pyramid_cells(levels), 4), np.float32)
+    out[:, :3] = stored
+    return out
+
+
+def scene_pyramids(patches: np.ndarray, rational: np.ndarray, levels: int = SUBPATCH_LEVELS) -> tuple[np.ndarray, np.ndarray]:
+    """((R * cells, 4) float32 pyramids of the rational patches, (P,) int32 their index (-1: none,
+    a polynomial patch, which keeps today's factors))."""
+    index = np.full(len(patches), -1, np.int32)
+    index[rational] = np.arange(int(np.count_nonzero(rational)), dtype=np.int32)
+    if not rational.any():
+        return np.zeros((1, 4), np.float32), index
+    tables = [majorant_pyramid(subpatch_majorants(patch, levels)) for patch in np.asarray(patches)[rational]]
+    return np.concatenate(tables), index
+
+
+# --- the per-triangle bound (kernels/criteria/integral_bound.h) --------------------------------
+
+def pyramid_query(pyramid: np.ndarray, levels: int, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """(3,) max of (m_uu, m_uv, m_vv) over the cells of one patch's pyramid that the box
+    [lo, hi] (u, v in [0, 1], widened by BOX_WIDENING) meets, at the finest level where it spans
+    at most QUERY_SPAN cells per side (float32 arithmetic as the kernel's)."""
+    side = np.float32(1 << levels)
+    w = np.float32(BOX_WIDENING)
+    first = [int(min(max(math.floor((np.float32(lo[a]) - w) * side), 0), side - 1)) for a in range(2)]
+    last = [int(min(max(math.floor((np.float32(hi[a]) + w) * side), 0), side - 1)) for a in range(2)]
+    level = 0
+    while level < levels and (last[0] - first[0] >= QUERY_SPAN or last[1] - first[1] >= QUERY_SPAN):
+        first, last, level = [x >> 1 for x in first], [x >> 1 for x in last], level + 1
+    offset, n = pyramid_levels(levels)[level]
+    cells = pyramid[offset:offset + n * n, :3].reshape(n, n, 3)
+    return cells[first[1]:last[1] + 1, first[0]:last[0] + 1].reshape(-1, 3).max(axis=0)
+
+
+def sub_triangles(k: int) -> np.ndarray:
+    """(k^2, 3, 3) integer barycentric corners (times k) of the k^2 sub-triangles of a triangle,
+    in the kernel's order (row i, then j; the upright one, then the inverted one)."""
+    out = []
+    for i in range(k):
+        for j in range(k - i):
+            out.append([[i, j, k - i - j], [i + 1, j, k - i - j - 1], [i, j + 1, k - i - j - 1]])
+            if i + j < k - 1:
+                out.append([[i + 1, j, k - i - j - 1], [i, j + 1, k - i - j - 1], [i + 1, j + 1, k - i - j - 2]])
+    return np.array(out, np.int64)
+
+
+def lemma1_box(pyramid: np.ndarray, levels: int, corners: np.ndarray) -> float:
+    """Lemma 1 with the majorant of the triangle's own bounding box (its local sups)."""
+    corners = corners.astype(np.float32)
+    lo, hi = corners.min(axis=0), corners.max(axis=0)
+    m = pyramid_query(pyramid, levels, lo, hi).astype(np.float32)
+    du, dv = hi - lo + np.float32(2) * np.float32(BOX_WIDENING)
+    return float((m[0] * du * du + np.float32(2) * m[1] * du * dv + m[2] * dv * dv) / np.float32(8))
+
+
+def upper_sum(pyramid: np.ndarray, levels: int, corners: np.ndarray, k: int) -> float:
+    """The upper sum of the integral form over the K^2 sub-triangles and T = 4K/3 intervals
+    (float32 as the kernel; the max over sub-triangles)."""
+    f32 = np.float32
+    corners = corners.astype(f32)
+    t_count = 4 * k // 3
+    worst = f32(0)
+    for sub in sub_triangles(k):
+        q = np.array([[(f32(sub[a, 0]) * corners[0, c] + f32(sub[a, 1]) * corners[1, c] + f32(sub[a, 2]) * corners[2, c])
+                       / f32(k) for c in range(2)] for a in range(3)], f32)
+        total = f32(0)
+        for i in range(3):
+            lam = f32(sub[:, i].max()) / f32(k)
+            x_i = corners[i]
+            h = np.abs(x_i - q).max(axis=0) + np.float32(BOX_WIDENING)  # the float32 corners' rounding
+            for s in range(t_count):
+                t0, t1 = f32(s) / f32(t_count), f32(s + 1) / f32(t_count)
+                weight = (t1 - t0) - (t1 * t1 - t0 * t0) / f32(2)
+                pts = np.concatenate([(f32(1) - t0) * q + t0 * x_i, (f32(1) - t1) * q + t1 * x_i])
+                m = pyramid_query(pyramid, levels, pts.min(axis=0), pts.max(axis=0)).astype(f32)
+                total += lam * weight * (m[0] * h[0] * h[0] + f32(2) * m[1] * h[0] * h[1] + m[2] * h[1] * h[1])
+        worst = max(worst, total)
+    return float(worst)
+
+
+def triangle_bound(pyramid: np.ndarray, levels: int, corners: np.ndarray, tolerance: float,
+                   subdivisions=SUBDIVISIONS) -> float:
+    """bound * BOUND_SAFETY / tolerance of one triangle (corners (3, 2) in (u, v)): Lemma 1 with its
+    box's majorant, then the upper sums for K in ``subdivisions`` until one is <= tolerance (each
+    is a bound: the smallest found is returned)."""
+    best = lemma1_box(pyramid, levels, corners) * BOUND_SAFETY
+    for k in subdivisions:
+        if best <= tolerance:
+            break
+        best = min(best, upper_sum(pyramid, levels, corners, k) * BOUND_SAFETY)
+    return best / tolerance
+
+
+# --- the trials (the host loop: cltess/backends/opencl/integral.py) -------------------------------
+
+def trial_factors(factors: np.ndarray, trials: np.ndarray) -> np.ndarray:
+    """(P, 4) int32: stage 1's factors ``factors`` (today's, (m, n, m, n) for a quad) scaled by
+    TRIAL_SCALES[trials] and rounded up, at least 1; 0 (culled) stays 0.  Never above today's."""
+    scales = np.asarray(TRIAL_SCALES)[trials][:, None]
+    scaled = np.ceil(factors * scales - 1e-9).astype(np.int32)
+    return np.where(factors > 0, np.clip(scaled, 1, factors), factors).astype(np.int32)

@@ -1,0 +1,224 @@
+"""Request(bound="integral") (issue 9: the integral form of the remainder in the engine,
+docs/rational-bound.md): the kernel against its NumPy mirror, the per-triangle bound against
+dense float64 measurement (transition triangles included), factors never above the hull
+bound's, watertight closed scenes, finite output, the option's validation."""
+import re
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from cltess.backends.opencl.integral import LAST_TRIAL, triangle_ratios
+from cltess.backends.opencl.programs import kernel_dir
+from cltess.criteria import integral
+from cltess.io import load_scene
+from cltess.reference import surface_points
+from cltess.request import Request
+from cltess.scene import Scene
+from support import SCENES, closed_torus_grid, random_patches, weld_exact
+
+LEVELS = 4  # small pyramids for the mirror tests (the engine's: integral.SUBPATCH_LEVELS)
+
+
+def dense_errors(patches, positions, uv, patch_ids, triangles, order=12) -> np.ndarray:
+    """(T,) max |p(u, v) - mesh(u, v)| over barycentric points of order ``order`` (float64, at
+    the mesh's float32 vertex positions and (u, v))."""
+    bary = np.array([(i, j, order - i - j) for i in range(order + 1) for j in range(order + 1 - i)], float) / order
+    tris = np.asarray(triangles, np.int64)
+    out = np.zeros(len(tris))
+    for start in range(0, len(tris), 2000):
+        t = tris[start:start + 2000]
+        pid = np.repeat(patch_ids[t[:, 0]], len(bary))
+        at = np.einsum("sk,tkc->tsc", bary, uv[t].astype(float)).reshape(-1, 2)
+        mesh = np.einsum("sk,tkc->tsc", bary, positions[t].astype(float)).reshape(-1, 3)
+        exact = surface_points(patches, pid, at[:, 0], at[:, 1])
+        out[start:start + 2000] = np.linalg.norm(exact - mesh, axis=1).reshape(len(t), -1).max(axis=1)
+    return out
+
+
+def test_host_and_device_constants_agree():
+    header = (kernel_dir() / "criteria" / "integral_bound.h").read_text()
+    define = lambda name: re.search(rf"#define {name} ([0-9.e+-]+)f?", header).group(1)  # noqa: E731
+    assert float(define("INTEGRAL_BOX_WIDENING")) == integral.BOX_WIDENING
+    assert int(define("INTEGRAL_QUERY_SPAN")) == integral.QUERY_SPAN
+    assert np.float32(define("INTEGRAL_BOUND_SAFETY")) == np.float32(integral.BOUND_SAFETY)
+    k = integral.SUBDIVISIONS  # the kernel doubles K from the first to the last
+    assert all(b == 2 * a for a, b in zip(k, k[1:]))
+
+
+def test_subpatch_majorants_hold_and_pyramid_bounds_them(rng):
+    sys.path.insert(0, str(SCENES.parent / "bench"))
+    from ratio_floor import second_derivatives
+
+    for patch in random_patches(rng, 3):
+        majorants = integral.subpatch_majorants(patch, 3)  # (8, 8, 3)
+        s = (np.arange(8)[:, None] + np.linspace(0, 1, 6)[None]) / 8
+        for j in range(8):
+            for i in range(8):
+                u, v = (x.ravel() for x in np.meshgrid(s[i], s[j]))
+                found = np.array([np.linalg.norm(d, axis=1).max() for d in second_derivatives(patch, u, v)])
+                assert (found <= majorants[j, i] * (1 + 1e-9)).all()
+        pyramid = integral.majorant_pyramid(majorants)
+        assert (pyramid[:64, :3].astype(float) >= majorants.reshape(-1, 3)).all()  # rounded up
+        assert np.allclose(pyramid[-1, :3], majorants.max(axis=(0, 1)), rtol=1e-5)  # the coarsest: the max
+
+
+@pytest.mark.parametrize("subdivisions", [(2,), (2, 4)])
+def test_kernel_matches_the_numpy_mirror(tessellator, rng, subdivisions):
+    patches = random_patches(rng, 3)
+    pyramids, index = integral.scene_pyramids(patches, np.ones(3, bool), LEVELS)
+    cells = integral.pyramid_cells(LEVELS)
+    count = 30
+    corners = rng.uniform(0, 1, (count, 3, 2)).astype(np.float32)
+    corners[:8] *= rng.uniform(0.02, 0.3, (8, 1, 1)).astype(np.float32)  # small, near a corner
+    owner = rng.integers(0, 3, count)
+    tolerances = rng.uniform(0.05, 5.0, 3)
+    uv = corners.reshape(-1, 2)
+    patch_ids = np.repeat(owner, 3).astype(np.int32)
+    triangles = np.arange(3 * count, dtype=np.uint32).reshape(count, 3)
+    check = np.array([1, 1, 0], np.int32)
+    got = triangle_ratios(tessellator, pyramids, index, check, uv, patch_ids, triangles,
+                          tolerances.astype(np.float32), subdivisions, LEVELS)
+    for t in range(count):
+        p = owner[t]
+        if not check[p]:
+            assert got[t] == 0
+            continue
+        want = integral.triangle_bound(pyramids[p * cells:(p + 1) * cells], LEVELS, corners[t],
+                                       np.float32(tolerances[p]), subdivisions)
+        assert got[t] == pytest.approx(want, rel=2e-5), t
+
+
+def test_triangle_bounds_hold_on_random_triangles(tessellator, rng):
+    """The engine's bound (kernel, engine's levels and K) >= the error densely measured."""
+    patches = random_patches(rng, 4)
+    pyramids, index = integral.scene_pyramids(patches, np.ones(4, bool))
+    count = 200
+    corners = rng.uniform(0, 1, (count, 3, 2))
+    corners[:60] = corners[:60] * rng.uniform(0.01, 0.2, (60, 1, 1))  # near corner (0, 0), where spikes are
+    corners = corners.astype(np.float32)
+    owner = rng.integers(0, 4, count)
+    uv = corners.reshape(-1, 2)
+    patch_ids = np.repeat(owner, 3)
+    positions = surface_points(patches, patch_ids, uv[:, 0].astype(float), uv[:, 1].astype(float))
+    triangles = np.arange(3 * count).reshape(count, 3)
+    error = dense_errors(patches, positions, uv, patch_ids, triangles)
+    tolerance = np.full(4, 1e-3, np.float32)  # small: every triangle takes the upper sums up to K = 24
+    ratios = triangle_ratios(tessellator, pyramids, index, np.ones(4, np.int32), uv, patch_ids, triangles, tolerance)
+    assert (error <= ratios * 1e-3).all(), (error / (ratios * 1e-3)).max()
+    assert (error > 0.3 * ratios * 1e-3).any()  # and not idle
+
+
+def _integral_and_hull(tessellator, scene, eps):
+    integral_plan = tessellator.plan(scene, eps=eps, bound="integral", max_factor=4096)
+    hull_plan = tessellator.plan(scene, eps=eps, max_factor=4096)
+    return integral_plan, hull_plan
+
+
+@pytest.mark.parametrize("relative_eps", [3e-2, 3e-3])
+def test_every_emitted_triangle_is_certified_on_a_rational_grid(tessellator, rng, relative_eps):
+    """A closed grid of rational patches (weights 0.2 to 5): patches end at different trials,
+    so transition triangles join different factors.  Every emitted triangle is either of a patch
+    at today's factors or bounded by the kernel <= its tolerance, and that bound holds."""
+    scene = closed_torus_grid(rng, 4, 3, weights=(0.2, 5.0))
+    eps = relative_eps * scene.diagonal
+    plan, hull = _integral_and_hull(tessellator, scene, eps)
+    final, today = plan.factors.get(), hull.factors.get()
+    assert (np.abs(final) <= np.abs(today)).all()  # never above the hull bound's
+    assert plan.num_indices < hull.num_indices
+    trials = plan.integral_trials
+    assert len(set(trials.tolist())) > 1  # patches at different trials
+    tess = tessellator.emit(plan, 0, plan.num_patches)
+    assert np.isfinite(tess.positions).all() and np.isfinite(tess.normals).all()
+    patches = np.asarray(scene.patches, float)
+    pyramids, index = integral.scene_pyramids(patches, np.ones(len(patches), bool))
+    owner = tess.patch_ids[tess.triangles[:, 0]]
+    ratios = triangle_ratios(tessellator, pyramids, index, np.ones(len(patches), np.int32), tess.uv,
+                             tess.patch_ids, tess.triangles, np.full(len(patches), eps, np.float32))
+    certified = (trials[owner] == LAST_TRIAL) | (ratios <= 1.0)
+    assert certified.all()
+    f = np.abs(final)
+    transition = (f[owner][:, 0] != f[owner][:, 2]) | (f[owner][:, 1] != f[owner][:, 3])
+    assert transition.any()  # crack-free raised an edge factor somewhere
+    error = dense_errors(patches, tess.positions, tess.uv, tess.patch_ids, tess.triangles)
+    checked = trials[owner] < LAST_TRIAL
+    assert (error[checked] <= ratios[checked] * eps).all()
+    assert error.max() <= eps
+    mesh = weld_exact(tess.positions, tess.triangles)
+    edges = np.sort(mesh.edges, axis=1)
+    _, uses = np.unique(edges, axis=0, return_counts=True)
+    assert (uses == 2).all()  # closed, manifold
+
+
+@pytest.mark.parametrize("name", ["sphere.bpt", "torus.bpt"])
+@pytest.mark.parametrize("relative_eps", [3e-2, 1e-3])
+def test_closed_rational_scenes_stay_watertight(tessellator, name, relative_eps):
+    scene = load_scene(SCENES / name)
+    eps = relative_eps * scene.diagonal
+    plan, hull = _integral_and_hull(tessellator, scene, eps)
+    assert (np.abs(plan.factors.get()) <= np.abs(hull.factors.get())).all()
+    tess = tessellator.emit(plan, 0, plan.num_patches)
+    assert np.isfinite(tess.positions).all() and np.isfinite(tess.normals).all()
+    mesh = weld_exact(tess.positions, tess.triangles)
+    _, uses = np.unique(np.sort(mesh.edges, axis=1), axis=0, return_counts=True)
+    assert (uses == 2).all()
+    error = dense_errors(np.asarray(scene.patches, float), tess.positions, tess.uv, tess.patch_ids, tess.triangles,
+                         order=6)
+    assert error.max() <= eps
+
+
+def test_polynomial_patches_keep_the_hull_factors(tessellator):
+    scene = load_scene(SCENES / "teapot.bez")
+    plan, hull = _integral_and_hull(tessellator, scene, 1e-2)
+    assert (plan.factors.get() == hull.factors.get()).all()
+    assert plan.stats["integral_patches"] == 0 and plan.stats["integral_rounds"] == 0
+
+
+def test_screen_space_and_a_mixed_scene(tessellator, rng):
+    """Polynomial and rational patches together, eps per patch: the certified bound holds."""
+    patches = np.concatenate([random_patches(rng, 4), load_scene(SCENES / "teapot.bez").patches[:4]])
+    scene = Scene(patches, np.zeros(len(patches), np.int32), name="mixed")
+    eps = 1e-2 * scene.diagonal
+    plan, hull = _integral_and_hull(tessellator, scene, eps)
+    assert plan.stats["integral_patches"] == 4
+    final, today = plan.factors.get(), hull.factors.get()
+    assert (final <= today).all() and (final[4:] == today[4:]).all()
+    tess = tessellator.emit(plan, 0, plan.num_patches)
+    assert dense_errors(patches, tess.positions, tess.uv, tess.patch_ids, tess.triangles, 8).max() <= eps
+
+
+def test_trial_factors_never_exceed_todays(rng):
+    today = rng.integers(0, 5000, (200, 4)).astype(np.int32)
+    today[:20] = 0  # culled
+    for trial in range(len(integral.TRIAL_SCALES)):
+        got = integral.trial_factors(today, np.full(200, trial))
+        assert (got <= today).all() and ((got >= 1) | (today == 0)).all()
+    assert (integral.trial_factors(today, np.full(200, LAST_TRIAL)) == today).all()
+
+
+def test_request_and_cli_refuse_what_the_option_cannot_do(tmp_path):
+    with pytest.raises(ValueError, match="bound must be one of"):
+        Request.of(eps=1.0, bound="exact")
+    with pytest.raises(ValueError, match="cannot be used with pattern"):
+        Request.of(eps=1.0, bound="integral", pattern="semi_uniform")
+    from cltess.backends.numpy import NumpyBackend
+    from cltess.session import Session
+
+    scene = load_scene(SCENES / "torus.bpt")
+    with pytest.raises(ValueError, match="OpenCL backend"):
+        NumpyBackend().plan(scene, Request.of(eps=1.0, bound="integral"))
+    with pytest.raises(ValueError, match="Session"):
+        Session(scene, eps=1.0, bound="integral").tessellate()
+    run = subprocess.run([sys.executable, "-m", "cltess", "tessellate", str(SCENES / "torus.bpt"), "--eps", "0.1",
+                          "--bound", "integral", "--pattern", "semi-uniform", "-o", str(tmp_path / "t.ply")],
+                         capture_output=True, text=True)
+    assert run.returncode == 2 and "--bound integral" in run.stderr and not (tmp_path / "t.ply").exists()
+
+
+def test_cli_bound_integral_writes_fewer_triangles(tmp_path):
+    out = tmp_path / "r.ply"
+    run = subprocess.run([sys.executable, "-m", "cltess", "tessellate", str(SCENES / "torus.bpt"), "--eps", "0.02",
+                          "--bound", "integral", "--verify", "-o", str(out)], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    assert "integral rounds" in run.stdout and "warning" not in run.stderr
