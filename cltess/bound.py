@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from .criteria.filip import pn_tolerances
-from .criteria.tolerance import patch_tolerances
+from .criteria.tolerance import factor_tolerances, patch_tolerances
 from .surfaces.bezier import surface_points
 from .surfaces.pn import pn_control_points, pn_surface_points
 
@@ -42,15 +42,23 @@ def _pn_controls(scene, sharp_edges: str) -> np.ndarray:
 
 
 def scene_tolerances(scene, eps: float | None = None, pixels: float | None = None,
-                     sharp_edges: str = "straight") -> np.ndarray:
+                     sharp_edges: str = "straight", for_factors: bool = False) -> np.ndarray:
     """(P,) float64: every patch's tolerance in scene numbering (Bézier patches, then PN
-    triangles), as stage 1 computes it (criteria.tolerance.patch_tolerances, filip.pn_tolerances)."""
+    triangles), as stage 1 computes it (criteria.tolerance.patch_tolerances, filip.pn_tolerances);
+    for_factors: what its factors may spend of it (less the float32 rounding allowance,
+    criteria.tolerance.factor_tolerances)."""
     tolerances = []
     if scene.num_bezier:
-        tolerances.append(patch_tolerances(np.asarray(scene.patches, float), eps, pixels, scene.camera)[0])
+        patches = np.asarray(scene.patches, float)
+        points = (patches[..., :3] / patches[..., 3:]).reshape(len(patches), -1, 3)
+        tolerances.append((patch_tolerances(patches, eps, pixels, scene.camera)[0], points))
     if scene.num_triangles:
-        tolerances.append(pn_tolerances(_pn_controls(scene, sharp_edges), eps, pixels, scene.camera)[0])
-    return np.concatenate(tolerances) if tolerances else np.zeros(0)
+        controls = _pn_controls(scene, sharp_edges)
+        tolerances.append((pn_tolerances(controls, eps, pixels, scene.camera)[0], np.asarray(controls, float)[:, :10, :3]))
+    if for_factors:
+        tolerances = [(factor_tolerances(points.min(axis=1), points.max(axis=1), tolerance), points)
+                      for tolerance, points in tolerances]
+    return np.concatenate([tolerance for tolerance, _ in tolerances]) if tolerances else np.zeros(0)
 
 
 def worst_bound_ratio(scene, mesh, eps: float | None = None, pixels: float | None = None,

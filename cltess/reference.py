@@ -5,8 +5,9 @@ NumPy backend (cltess.backends.numpy); the engine imports none of it from here."
 from .backends.numpy import counts, offsets, pn_tessellate, tessellate
 from .crack.adjacency import crack_free_factors
 from .criteria.base import DEFAULT_MAX_FACTOR
-from .criteria.filip import pn_factors, pn_inverse_steps, pn_second_derivative_bounds, pn_tolerances
-from .criteria.tolerance import box_tolerances, patch_tolerances
+from .criteria.filip import (pn_factor_tolerances, pn_factors, pn_inverse_steps, pn_second_derivative_bounds,
+                             pn_tolerances)
+from .criteria.tolerance import box_tolerances, patch_factor_tolerances, patch_tolerances
 from .criteria.zheng_sederberg import (diagonal_majorant, second_derivative_bounds, second_derivative_hull, zs_factors,
                                        zs_inverse_steps, zs_steps)
 from .patterns import quad_pattern, tri_pattern
@@ -16,7 +17,7 @@ from .surfaces.bezier import (NORMAL_DEGENERATE, NORMAL_SHIFT, bernstein2, berns
 from .surfaces.pn import (CUBIC, EDGE_DIRECTIONS, PN_NORMAL_VANISHES, QUADRATIC, pn_control_points,
                           pn_edge_control, pn_evaluate, pn_folded, pn_surface_points)
 
-__all__ = ["patch_tolerances", "box_tolerances", "zs_factors", "zs_inverse_steps", "zs_steps", "second_derivative_bounds",
+__all__ = ["patch_tolerances", "patch_factor_tolerances", "pn_factor_tolerances", "box_tolerances", "zs_factors", "zs_inverse_steps", "zs_steps", "second_derivative_bounds",
            "second_derivative_hull", "diagonal_majorant", "crack_free_factors",
            "quad_pattern", "counts", "offsets", "evaluate", "surface_points", "tessellate", "boundary_point",
            "boundary_curves", "pn_control_points", "pn_edge_control", "pn_second_derivative_bounds",

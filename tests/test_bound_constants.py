@@ -8,6 +8,7 @@ import pytest
 
 from cltess.backends.opencl.tessellator import Tessellator
 from cltess.criteria import ObjectSpace
+from cltess.criteria.tolerance import patch_factor_tolerances
 from cltess.criteria.zheng_sederberg import zs_constant_steps, zs_constants, zs_factors
 from cltess.io import load_scene
 from cltess.kinds import BEZIER
@@ -105,7 +106,7 @@ def test_factors_from_kept_constants_equal_the_reference(tessellator, rng, eps):
     patches = as_float32(random_patches(rng, 500))
     count = len(patches)
     data = tessellator.upload(BEZIER, np.ascontiguousarray(patches.reshape(-1, 16, 4), np.float32))
-    expected, unclamped, _ = zs_factors(patches, np.full(count, eps), max_factor=4096)
+    expected, unclamped, _ = zs_factors(patches, patch_factor_tolerances(patches, eps)[0], max_factor=4096)
     tipping = (np.abs(unclamped - np.round(unclamped)) < 1e-4 * unclamped).any(axis=1)
     runs = []
     for _ in range(2):

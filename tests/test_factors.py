@@ -28,7 +28,8 @@ def assert_factors_match(got, expected, unclamped, rounding=1e-4):
 def test_factors_match_reference_on_random_rational_patches(tessellator, rng, eps):
     patches = random_patches(rng, 3000)
     got, flags = device_factors(tessellator, patches, eps=eps)
-    expected, unclamped, saturated = reference.zs_factors(as_float32(patches), np.full(len(patches), eps))
+    expected, unclamped, saturated = reference.zs_factors(as_float32(patches),
+                                                           reference.patch_factor_tolerances(as_float32(patches), eps)[0])
     assert_factors_match(got, expected, unclamped)
     assert np.array_equal(flags & 1, saturated.astype(int))
     assert (got[:, 0] == got[:, 2]).all() and (got[:, 1] == got[:, 3]).all()
@@ -37,7 +38,8 @@ def test_factors_match_reference_on_random_rational_patches(tessellator, rng, ep
 def test_saturated_patches_are_flagged_and_clamped(tessellator, rng):
     patches = random_patches(rng, 500)
     got, flags = device_factors(tessellator, patches, eps=1e-3, max_factor=16)
-    expected, _, saturated = reference.zs_factors(as_float32(patches), np.full(len(patches), 1e-3), max_factor=16)
+    expected, _, saturated = reference.zs_factors(as_float32(patches), reference.patch_factor_tolerances(
+        as_float32(patches), 1e-3)[0], max_factor=16)
     assert saturated.sum() > 100
     assert got.max() == 16 and np.array_equal(flags & 1, saturated.astype(int))
 
@@ -46,7 +48,7 @@ def test_screen_space_tolerance_and_culling_match_reference(tessellator, rng):
     patches = random_patches(rng, 3000)
     camera = Camera(eye=np.array([20.0, 3.0, 1.0]), target=np.zeros(3), fov_y_deg=40)
     got, flags = device_factors(tessellator, patches, pixels=0.5, camera=camera, max_factor=4096)
-    eps, culled = reference.patch_tolerances(as_float32(patches), pixels=0.5, camera=camera)
+    eps, culled = reference.patch_factor_tolerances(as_float32(patches), pixels=0.5, camera=camera)
     expected, unclamped, _ = reference.zs_factors(as_float32(patches), eps, culled, max_factor=4096)
     assert 0 < culled.sum() < len(patches)
     assert np.array_equal((flags & 2) > 0, culled)
@@ -69,7 +71,8 @@ def test_tolerance_is_raised_to_the_float32_floor_where_the_patch_lies(tessellat
     floor = FLOAT32_TOLERANCE_STEPS * np.spacing(np.abs(points).reshape(len(points), -1).max(1).astype(np.float32))
     raised = tolerance == floor
     assert raised[~culled].sum() > 50 and (tolerance >= floor).all()
-    expected, unclamped, _ = reference.zs_factors(patches, tolerance, culled, max_factor=4096)
+    spent = reference.patch_factor_tolerances(patches, eps=eps, pixels=pixels, camera=camera)[0]  # less the rounding
+    expected, unclamped, _ = reference.zs_factors(patches, spent, culled, max_factor=4096)
     assert np.array_equal((flags & 2) > 0, culled)
     # The float32 constants of patches ~100 from the origin carry ~1e-5 relative error (w X
     # rounded before centring), so a ceil may tip a little farther from an integer than near it.
@@ -181,7 +184,8 @@ def test_pn_factors_match_reference_on_random_triangles(tessellator, rng, eps):
 
     triangles = random_pn_triangles(rng, 3000)
     controls, got, flags = device_pn_factors(tessellator, triangles, eps=eps)
-    expected, unclamped, saturated = reference.pn_factors(controls.astype(np.float64), np.full(len(got), eps))
+    expected, unclamped, saturated = reference.pn_factors(controls.astype(np.float64),
+                                                           reference.pn_factor_tolerances(controls, eps)[0])
     assert_factors_match(got[:, :3], expected[:, :3], unclamped)
     assert (got[:, 3] == 0).all() and (got[:, :3] >= 1).all()
     assert np.array_equal(flags & 1, saturated.astype(int))
@@ -199,7 +203,7 @@ def test_folded_triangles_get_no_factors(tessellator, rng):
     folded = reference.pn_folded(controls)
     assert folded.sum() == 20 and (got[folded] == 0).all() and (flags[folded] == 4).all()
     assert (got[~folded, :3] > 0).all() and not (flags[~folded] & 4).any()
-    assert np.array_equal(reference.pn_factors(controls.astype(np.float64), np.full(30, 0.01))[0] == 0,
+    assert np.array_equal(reference.pn_factors(controls.astype(np.float64), reference.pn_factor_tolerances(controls, 0.01)[0])[0] == 0,
                           np.repeat(folded[:, None], 4, 1) | (np.arange(4) == 3))
 
 
@@ -209,7 +213,7 @@ def test_pn_screen_space_tolerance_and_culling_match_reference(tessellator, rng)
     triangles = random_pn_triangles(rng, 3000)
     camera = Camera(eye=np.array([12.0, 3.0, 1.0]), target=np.zeros(3), fov_y_deg=40)
     controls, got, flags = device_pn_factors(tessellator, triangles, pixels=0.5, camera=camera, max_factor=4096)
-    eps, culled = reference.pn_tolerances(controls.astype(np.float64), pixels=0.5, camera=camera)
+    eps, culled = reference.pn_factor_tolerances(controls.astype(np.float64), pixels=0.5, camera=camera)
     expected, unclamped, _ = reference.pn_factors(controls.astype(np.float64), eps, culled, max_factor=4096)
     assert 0 < culled.sum() < len(triangles)
     assert np.array_equal((flags & 2) > 0, culled)
@@ -222,7 +226,8 @@ def test_pn_saturated_triangles_are_flagged_and_clamped(tessellator, rng):
 
     triangles = random_pn_triangles(rng, 500)
     controls, got, flags = device_pn_factors(tessellator, triangles, eps=1e-4, max_factor=8)
-    _, _, saturated = reference.pn_factors(controls.astype(np.float64), np.full(500, 1e-4), max_factor=8)
+    _, _, saturated = reference.pn_factors(controls.astype(np.float64), reference.pn_factor_tolerances(controls, 1e-4)[0],
+                                          max_factor=8)
     assert saturated.sum() > 100
     assert got.max() == 8 and np.array_equal(flags & 1, saturated.astype(int))
 

@@ -139,7 +139,7 @@ def test_exact_corners_project_to_their_float32_points(rng):
 
 
 def test_the_cli_raises_a_tolerance_below_float32_steps_says_so_and_welds_clean(capsys, tmp_path):
-    """Issue 9: the sphere moved by 1e5 with eps 0.001 (0.13 float32 steps there) gets 2 steps
+    """Issue 9: the sphere moved by 1e5 with eps 0.001 (0.13 float32 steps there) gets 6 steps
     per patch instead (criteria.tolerance.FLOAT32_TOLERANCE_STEPS), the warning before the run
     says so, and the written mesh welds closed with no degenerate triangle."""
     import json
@@ -154,6 +154,6 @@ def test_the_cli_raises_a_tolerance_below_float32_steps_says_so_and_welds_clean(
     assert main(["tessellate", str(scene), "--eps", "0.001", "-q", "-o", str(out)]) == 0
     err = capsys.readouterr().err
     assert f"cltess: warning: {scene}: eps 0.001 is below 16 float32 steps" in err
-    assert "get that instead (up to 0.0156 here)" in err
+    assert "get that instead (up to 0.0469 here)" in err
     with np.load(out) as mesh:
         assert_clean(SimpleNamespace(positions=mesh["positions"], triangles=mesh["triangles"]))

@@ -7,7 +7,7 @@ import numpy as np
 from ..scene import Camera
 from ..surfaces.pn import _CUBIC_AT, pn_folded
 from .base import DEFAULT_MAX_FACTOR
-from .tolerance import box_tolerances
+from .tolerance import box_tolerances, factor_tolerances
 
 
 def pn_second_derivative_bounds(controls: np.ndarray) -> np.ndarray:
@@ -50,6 +50,16 @@ def pn_tolerances(controls: np.ndarray, eps: float | None = None, pixels: float 
     """patch_tolerances for PN triangles: the box of the ten control points."""
     points = np.asarray(controls, float)[:, :10, :3]
     return box_tolerances(points.min(axis=1), points.max(axis=1), eps, pixels, camera)
+
+
+def pn_factor_tolerances(controls: np.ndarray, eps: float | None = None, pixels: float | None = None,
+                         camera: Camera | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """pn_tolerances less the float32 rounding allowance (tolerance.factor_tolerances): what
+    stage 1's factors spend."""
+    points = np.asarray(controls, float)[:, :10, :3]
+    lo, hi = points.min(axis=1), points.max(axis=1)
+    eps, culled = box_tolerances(lo, hi, eps, pixels, camera)
+    return factor_tolerances(lo, hi, eps), culled
 
 
 def pn_factors(controls: np.ndarray, eps: np.ndarray, culled: np.ndarray | None = None,

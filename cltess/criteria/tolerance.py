@@ -17,14 +17,32 @@ from ..scene import Camera
 #: cannot hold a finer one, and below about one step neighbouring vertices round to one point
 #: (the sphere translated by 1e5 welded with degenerate triangles and non-manifold edges at 0.45
 #: steps, cleanly from 0.9; 2 keeps the translated sphere and torus clean up to 1e6).
-FLOAT32_TOLERANCE_STEPS = 2.0
+#: It is FLOAT32_ROUNDING_STEPS plus the 2 steps the factors kept at least before that allowance.
+FLOAT32_TOLERANCE_STEPS = 6.0
+#: Float32 steps of each patch's tolerance that its factors leave to rounding (kernels/criteria/
+#: tolerance.h FLOAT32_ROUNDING_STEPS; docs/design.md section 7): the control points rounded to
+#: float32, the move to the patch's centre and the output's rounding each move a point by up to
+#: sqrt(3)/2 step.  Without it the sphere at +1e5 measured 1.12 eps at eps = 1e-2 of its diagonal
+#: (2.4 steps of rounding), with no warning.
+FLOAT32_ROUNDING_STEPS = 4.0
+
+
+def float32_step(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """(P,) float64: one float32 step at the largest |coordinate| of each box lo, hi (P, 3)."""
+    largest = np.maximum(np.abs(lo), np.abs(hi)).max(axis=1).astype(np.float32)
+    return np.spacing(largest).astype(np.float64)
 
 
 def float32_tolerance_floor(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     """(P,) float64: FLOAT32_TOLERANCE_STEPS float32 steps at the largest |coordinate| of each
     box lo, hi (P, 3), as kernels/criteria/tolerance.h float32_tolerance_floor computes it."""
-    largest = np.maximum(np.abs(lo), np.abs(hi)).max(axis=1).astype(np.float32)
-    return FLOAT32_TOLERANCE_STEPS * np.spacing(largest).astype(np.float64)
+    return FLOAT32_TOLERANCE_STEPS * float32_step(lo, hi)
+
+
+def factor_tolerances(lo: np.ndarray, hi: np.ndarray, tolerance: np.ndarray) -> np.ndarray:
+    """What the factors may spend of each patch's tolerance: less the rounding allowance
+    (tolerance.h factor_tolerance)."""
+    return tolerance - FLOAT32_ROUNDING_STEPS * float32_step(lo, hi)
 
 
 @dataclass(frozen=True)
@@ -35,8 +53,10 @@ class ObjectSpace:
     defines = {}
 
     def reference(self, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(eps (P,), culled (P,)) for patches in boxes lo, hi (P, 3)."""
-        return box_tolerances(lo, hi, eps=self.eps)
+        """(what the factors may spend (P,), culled (P,)) for patches in boxes lo, hi (P, 3):
+        stage 1's mirror (factor_tolerances of box_tolerances)."""
+        eps, culled = box_tolerances(lo, hi, eps=self.eps)
+        return factor_tolerances(lo, hi, eps), culled
 
     def kernel_args(self) -> tuple:
         """eps, view, frustum, pixels, pixel_size: the tolerance arguments of stages/factors.cl."""
@@ -54,7 +74,8 @@ class ScreenSpace:
     defines = {"TOLERANCE_SCREEN": "1"}
 
     def reference(self, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        return box_tolerances(lo, hi, pixels=self.pixels, camera=self.camera)
+        eps, culled = box_tolerances(lo, hi, pixels=self.pixels, camera=self.camera)
+        return factor_tolerances(lo, hi, eps), culled
 
     def kernel_args(self) -> tuple:
         view, frustum, pixel_size = camera_arguments(self.camera)
@@ -72,6 +93,16 @@ def patch_tolerances(patches: np.ndarray, eps: float | None = None, pixels: floa
     """
     points = (patches[..., :3] / patches[..., 3:]).reshape(len(patches), -1, 3)
     return box_tolerances(points.min(axis=1), points.max(axis=1), eps, pixels, camera)
+
+
+def patch_factor_tolerances(patches: np.ndarray, eps: float | None = None, pixels: float | None = None,
+                            camera: Camera | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """(what each patch's factors may spend (P,), culled (P,)): patch_tolerances less the float32
+    rounding allowance (factor_tolerances), what stage 1 and its mirror (``reference``) use."""
+    points = (patches[..., :3] / patches[..., 3:]).reshape(len(patches), -1, 3)
+    lo, hi = points.min(axis=1), points.max(axis=1)
+    eps, culled = box_tolerances(lo, hi, eps, pixels, camera)
+    return factor_tolerances(lo, hi, eps), culled
 
 
 def box_tolerances(lo: np.ndarray, hi: np.ndarray, eps: float | None = None, pixels: float | None = None,

@@ -19,15 +19,34 @@ typedef struct {
 /* No patch gets a tolerance below this many float32 steps at its largest coordinate
  * (cltess.criteria.tolerance.FLOAT32_TOLERANCE_STEPS; docs/design.md section 7): the output's
  * float32 coordinates cannot hold a finer one, and below about one step neighbouring vertices
- * round to one point (degenerate, non-manifold welds far from the origin). */
-#define FLOAT32_TOLERANCE_STEPS 2.0f
+ * round to one point (degenerate, non-manifold welds far from the origin).  It is the rounding
+ * allowance below plus the 2 steps the factors kept at least before the allowance. */
+#define FLOAT32_TOLERANCE_STEPS 6.0f
 
-/* FLOAT32_TOLERANCE_STEPS float32 steps (ulps) at the largest |coordinate| of the box lo..hi. */
-inline float float32_tolerance_floor(float3 lo, float3 hi)
+/* Float32 steps of a patch's tolerance that its factors leave to rounding
+ * (cltess.criteria.tolerance.FLOAT32_ROUNDING_STEPS; docs/design.md section 7): the control
+ * points rounded to float32, the move to the patch's centre and the output's rounding each
+ * move a point by up to sqrt(3)/2 step; the sphere at +1e5 measured 2.4 steps. */
+#define FLOAT32_ROUNDING_STEPS 4.0f
+
+/* One float32 step (ulp) at the largest |coordinate| of the box lo..hi. */
+inline float float32_step(float3 lo, float3 hi)
 {
     float3 extent = max(fabs(lo), fabs(hi));
     float largest = max(max(extent.x, extent.y), extent.z);
-    return FLOAT32_TOLERANCE_STEPS * (nextafter(largest, INFINITY) - largest);
+    return nextafter(largest, INFINITY) - largest;
+}
+
+inline float float32_tolerance_floor(float3 lo, float3 hi)
+{
+    return FLOAT32_TOLERANCE_STEPS * float32_step(lo, hi);
+}
+
+/* What a patch's factors may spend of its tolerance eps (patch_tolerance): eps less the
+ * rounding allowance, so that the output, rounding included, stays within eps. */
+inline float factor_tolerance(float eps, float3 lo, float3 hi)
+{
+    return eps - FLOAT32_ROUNDING_STEPS * float32_step(lo, hi);
 }
 
 /* Object-space tolerance of the patch whose control points lie in the box lo..hi, and whether

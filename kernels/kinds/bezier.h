@@ -144,8 +144,9 @@ inline void edge_controls(const float4 b[16], int e, float4 c[4])
     }
 }
 
-/* The tolerance of a patch at its control points' bounding box (criteria/tolerance.h
- * patch_tolerance; the convex hull holds the patch); *culled when the box is out of view. */
+/* What the factors of a patch may spend, at its control points' bounding box (criteria/tolerance.h
+ * patch_tolerance less the rounding allowance, factor_tolerance; the convex hull holds the
+ * patch); *culled when the box is out of view. */
 ALWAYS_INLINE float bezier_tolerance(__private const float4 b[16], tolerance_args tol, __private int *culled)
 {
     float3 lo = b[0].xyz / b[0].w, hi = lo;
@@ -154,7 +155,7 @@ ALWAYS_INLINE float bezier_tolerance(__private const float4 b[16], tolerance_arg
         lo = min(lo, point);
         hi = max(hi, point);
     }
-    return patch_tolerance(lo, hi, tol, culled);
+    return factor_tolerance(patch_tolerance(lo, hi, tol, culled), lo, hi);
 }
 
 /* --- the kind contract (docs/extending.md) ----------------------------------------------------- */

@@ -167,7 +167,7 @@ inline int4 kind_factors(__global const float4 *source, __global float4 *control
         hi = max(hi, b[k].xyz);
     }
     int culled;
-    float eps = patch_tolerance(lo, hi, tol, &culled);
+    float eps = factor_tolerance(patch_tolerance(lo, hi, tol, &culled), lo, hi);
     if (culled) {
         *flags = FLAG_CULLED;
         return (int4)(0);

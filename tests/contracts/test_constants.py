@@ -76,3 +76,4 @@ def test_the_float32_tolerance_floor_equals_the_mirrors():
 
     found = defines("criteria/tolerance.h")
     assert np.float32(found["FLOAT32_TOLERANCE_STEPS"]) == np.float32(tolerance.FLOAT32_TOLERANCE_STEPS)
+    assert np.float32(found["FLOAT32_ROUNDING_STEPS"]) == np.float32(tolerance.FLOAT32_ROUNDING_STEPS)

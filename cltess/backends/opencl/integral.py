@@ -122,7 +122,7 @@ def plan_integral(tessellator, scene, request, started: float):
         pyramid_of_device = cl_array.to_device(tessellator.queue, pyramid_of)
         eps = request.tolerance.eps if isinstance(request.tolerance, ObjectSpace) else None
         pixels = request.tolerance.pixels if isinstance(request.tolerance, ScreenSpace) else None
-        tolerances = cl_array.to_device(tessellator.queue, scene_tolerances(scene, eps, pixels, request.sharp_edges)
+        tolerances = cl_array.to_device(tessellator.queue, scene_tolerances(scene, eps, pixels, request.sharp_edges, for_factors=True)
                                         .astype(np.float32))
         checked_at = np.full((count, 4), np.iinfo(np.int32).min, np.int32)
         while True:
