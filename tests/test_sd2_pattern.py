@@ -137,3 +137,37 @@ def test_tie_configuration_is_the_same_from_both_sides():
                 nearest = np.min([np.abs(one[:, None, list(p)] - other[None]).max(axis=(2, 3))
                                   for p in itertools.permutations(range(3))], axis=0).min(axis=1)
                 assert nearest.max() < 1e-4, (h, x, y, nearest.max())
+
+
+def same_surface(one_record, other_record, tolerance=1e-4) -> float:
+    """The largest distance (in the domain) from a non-degenerate triangle of one record's pattern to
+    the nearest of the other's (as corner positions, any order); inf when their numbers differ."""
+    def surface(record):
+        uv, triangles = sd2_pattern(record)
+        return uv[triangles[signed_areas(uv, triangles) > 2e-4]]  # (T, 3, 2)
+
+    one, other = surface(one_record), surface(other_record)
+    if len(one) != len(other):
+        return np.inf
+    return float(np.min([np.abs(one[:, None, list(p)] - other[None]).max(axis=(2, 3))
+                         for p in itertools.permutations(range(3))], axis=0).min(axis=1).max())
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.sampled_from([1, 3, 5, 7, 9]), st.integers(0, 2), st.integers(1, 64), st.integers(0, 2))
+def test_leaving_a_plateau_at_an_odd_factor_is_continuous(n, corner, delta, stay):
+    """A triple tie that lasts (a level function clamped at low or high: every corner's phi the
+    same odd whole n) left by one corner rising delta 16.16 units above it, or by two: the fans
+    that follow (in the tie zone, base corners tied with each other: lam = 1, docs/sd2.md section
+    5) start from the plateau's grid, whichever corner rises (at odd whole factors every tie
+    configuration is the regular lattice).  Before: lam was 1/2 there, a blend of two tie
+    configurations that no grid has."""
+    plateau = n * FIXED_ONE
+    phi = [plateau] * 3
+    phi[corner] += delta
+    if stay == 1:  # a second corner rising less
+        phi[(corner + 1) % 3] += delta // 2
+    grid = hinted_record([plateau] * 3)
+    assert sd2_shape(grid)[0] == "grid"
+    assert same_surface(hinted_record(phi), grid) < 1e-3, (n, corner, delta, phi)
+    check_pattern(hinted_record(phi), fold_tolerance=1e-7)

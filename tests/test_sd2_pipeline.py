@@ -12,7 +12,7 @@ import trimesh
 import cltess.backends.opencl.tessellator as tessellator_module
 from cltess.checks import t_junctions
 from cltess.io.camera_path import orbit
-from cltess.levels import level_hints, level_factors, vertex_bounds, vertex_levels, welded_corners
+from cltess.levels import DEFAULT_SILHOUETTE_BAND, level_hints, level_factors, vertex_bounds, vertex_levels, welded_corners
 from cltess.patterns.fractional import FIXED_ONE, to_fixed
 from cltess.patterns.sd2 import SD2, sd2_counts, sd2_shape, sd2_strip_indices
 from cltess.scene import Camera, Scene
@@ -72,11 +72,12 @@ def test_level_functions_equal_the_mirror(tessellator):
         else:
             values = vertex_levels(function, positions, normals, CAMERA)
             near, far = (values.min(), values.max()) if function == "depth" else (0, 1)
-            expected = level_factors(function, corners, values, "quadratic", near, far, 2.0, 9.0)
+            band = DEFAULT_SILHOUETTE_BAND
+            expected = level_factors(function, corners, values, "quadratic", near, far, 2.0, 9.0, band)
             assert np.abs(got - expected).max() <= 2, function  # float32 map against float64
             # the SD-2 hint in slot 3 (stored negated by stage 2): the smallest corner and its phi
             hints = np.abs(plan.host_factors()[:, 3].astype(np.int64))
-            mirror = level_hints(function, corners, values, "quadratic", near, far, 2.0, 9.0)
+            mirror = level_hints(function, corners, values, "quadratic", near, far, 2.0, 9.0, band)
             same = (hints & 3) == (mirror & 3)
             assert same.mean() > 0.99 and np.abs((hints >> 2) - (mirror >> 2))[same].max() <= 2, function
         assert (got >= 2 * FIXED_ONE).all() and (got <= 9 * FIXED_ONE).all() or function == "bound"
@@ -90,21 +91,27 @@ def test_random_vertex_values_with_ties_give_two_different_factors(rng):
     corners = mesh.faces
     for trial in range(20):
         values = rng.integers(0, 6, len(mesh.vertices)).astype(float)  # many ties
-        for function in ("depth", "silhouette", "bound"):
-            v = values if function != "silhouette" else (values > 2).astype(float)
+        for function, band in (("depth", 0), ("silhouette", 0), ("silhouette", 2.0), ("bound", 0)):
+            v = values if function != "silhouette" else (values - 2) / 4  # cosines, zeros (front) included
             v = 2 * v + 1 if function == "bound" else v
-            f = level_factors(function, corners, v, near=0, far=5, low=1, high=9)
-            for tri, fs in zip(corners, f):
+            f = level_factors(function, corners, v, near=0, far=5, low=1, high=9, band=band)
+            hints = level_hints(function, corners, v, near=0, far=5, low=1, high=9, band=band)
+            for tri, fs, hint in zip(corners, f, hints):
                 assert len(set(fs.tolist())) <= 2
                 shape, tip = sd2_shape(fs)
+                # every edge is the larger of its ends' phi; the hint names the smallest phi
+                m, phi_m = int(hint) & 3, int(hint) >> 2
+                assert m < 3 and 0 < phi_m <= fs.min()
                 if shape == "sd2":
                     own = v[tri]
                     if function == "depth":
                         assert own[tip] == own.min()
                     elif function == "bound":
                         assert own[tip] == own.max()
-                    else:
-                        assert (own == own[tip]).sum() == 1  # the odd corner
+                    elif ((own >= 0) != (own[tip] >= 0)).sum() == 2:
+                        pass  # the odd corner (crossed edges at the tip)
+                    else:  # one class: the corner nearest the silhouette (a ramp, band > 0)
+                        assert band > 0 and (own >= 0).all() | (own < 0).all() and abs(own[tip]) == np.abs(own).min()
 
 
 def random_level_factors(monkeypatch, rng, high=64.0):
@@ -216,7 +223,7 @@ def load_pops_bench():
     return module
 
 
-@pytest.mark.parametrize("function", ["bound", "silhouette", "depth"])
+@pytest.mark.parametrize("function", ["bound", "silhouette", "silhouette-ramp", "depth"])
 def test_the_numpy_backend_agrees(tessellator, rng, function):
     """The NumPy backend's SD-2 (cltess.levels.reference_level_factors, the pattern's mirror)
     against the OpenCL one on a scene of both kinds: factors, triangles, strips, positions."""
@@ -228,10 +235,11 @@ def test_the_numpy_backend_agrees(tessellator, rng, function):
     grid = closed_torus_grid(rng, 4, 3)
     mesh = icosphere(1)
     scene = Scene(grid.patches, grid.object_ids, name="mixed", meshes=mesh.meshes)
-    request = Request(ObjectSpace(0.02), pattern="sd2", level_function=function, camera=CAMERA,
-                      depth_range=(2.0, 4.0) if function == "depth" else None, level_factors=(1.5, 6.0))
+    request = Request(ObjectSpace(0.02), pattern="sd2", level_function=function.split("-")[0], camera=CAMERA,
+                      depth_range=(2.0, 4.0) if function == "depth" else None, level_factors=(1.5, 6.0),
+                      silhouette_band=0.3 if function == "silhouette-ramp" else 0.0)
     device, host = tessellator.tessellate(scene, request), NumpyBackend().tessellate(scene, request)
-    if function == "depth":  # float32 map against float64: a fixed-point ulp or two
+    if function in ("depth", "silhouette-ramp"):  # float32 map (the device's division) against ours: an ulp or two
         assert np.abs(device.real_factors - host.real_factors).max() < 1e-4
         return
     for name in ("factors", "real_factors", "triangles", "strips"):

@@ -80,8 +80,11 @@ def sd2_morph(f, c: int) -> tuple[bool, np.float32, np.float32]:
     """(in the tie zone, w, lam) of the fan with tip c (docs/sd2.md section 5).  w: the radial
     pattern's weight, ``(F - G) / 1.0`` (F the tip edges' factor, G the base's): 0 at a tie, the
     zone is w < 1.  lam: the weight of the tie configuration with partner c+1 against partner
-    c+2, ``e2 / (e1 + e2)``, e_k = F - phi_k the distance of base corner k from tying with the
-    tip (1/2 at a triple tie).  Outside the zone, or without a usable hint: (False, 1, 1)."""
+    c+2, ``min(e2 / e1, 1)``, e_k = F - phi_k the distance of base corner k from tying with the
+    tip: 1 at e1 = 0, 0 at e2 = 0, continuous elsewhere, and 1 when the base corners tie with each
+    other (e1 = e2: a plateau left by the tip starts from the tie configuration with partner c+1,
+    which at an odd whole factor is the plateau's grid).  Outside the zone, or without a usable
+    hint: (False, 1, 1)."""
     one = np.float32(1.0)
     hint = sd2_hint(f)
     big, base = int(f[c]), int(f[(c + 1) % 3])
@@ -91,7 +94,7 @@ def sd2_morph(f, c: int) -> tuple[bool, np.float32, np.float32]:
     e_m, e_other = big - phi_m, big - base
     e1, e2 = (e_m, e_other) if m == (c + 1) % 3 else (e_other, e_m)
     w = np.float32(e_other) * np.float32(1.0 / FIXED_ONE)
-    lam = np.float32(e2) / np.float32(e1 + e2) if e1 + e2 > 0 else np.float32(0.5)
+    lam = min(np.float32(np.float32(e2) / np.float32(e1)), np.float32(1.0)) if e1 > 0 else np.float32(1.0)
     return True, w, lam
 
 

@@ -75,7 +75,8 @@ inline int sd2_hint(int4 f, int *m, int *phi)
 
 /* The tie zone of the fan with tip c (mirror sd2_morph): 1 when in it, with *w the radial
  * pattern's weight (F - G) / 1.0 and *lam the weight of the tie with partner c+1,
- * e2 / (e1 + e2), e_k = F - phi_k. */
+ * min(e2 / e1, 1), e_k = F - phi_k (1 when the base corners tie with each other: a plateau left
+ * by the tip starts from one tie configuration, docs/sd2.md section 5). */
 inline int sd2_morph(int4 f, int c, float *w, float *lam)
 {
     int m, phi_m;
@@ -87,7 +88,7 @@ inline int sd2_morph(int4 f, int c, float *w, float *lam)
     int e_m = big - phi_m, e_other = big - base;
     int e1 = m == (c + 1) % 3 ? e_m : e_other, e2 = m == (c + 1) % 3 ? e_other : e_m;
     *w = (float)e_other * (1.0f / (float)FIXED_ONE);
-    *lam = e1 + e2 > 0 ? (float)e2 / (float)(e1 + e2) : 0.5f;
+    *lam = e1 > 0 ? fmin((float)e2 / (float)e1, 1.0f) : 1.0f;
     return 1;
 }
 
