@@ -239,8 +239,9 @@ def setting(scene) -> tuple[np.ndarray, float, tuple]:
 def frame_options(level_function: str, camera, low: float, high: float, band: float, depth_range, pixels: float):
     if level_function == "bound":  # the error bound at a screen-space tolerance of this frame's camera
         return dict(pixels=pixels, pattern="sd2", level_function="bound", max_factor=64)
-    return dict(eps=1e-3, pattern="sd2", level_function=level_function, camera=camera, level_factors=(low, high),
-                depth_range=depth_range, silhouette_band=band)
+    options = dict(eps=1e-3, pattern="sd2", level_function=level_function, camera=camera, level_factors=(low, high),
+                   depth_range=depth_range)
+    return dict(options, silhouette_band=band) if level_function == "silhouette" else options
 
 
 def measure(tessellator, scene, sweep: float, steps: int, low: float, high: float, level_function: str = "depth",
