@@ -24,6 +24,9 @@ bench/sd2.py's (the paper's sphere, and its violin case and cow sizes).  Columns
   median   the median over the steps of each step's largest
   jumps    steps whose largest is more than 4 x the median step (a pop's signature)
   tips     steps where some patch's tip moved to another corner (its shape changed)
+  triple   steps whose worst patch is near a triple tie (its three corners' factors within one
+           factor unit of each other, in either frame: docs/sd2.md section 5, "Triple ties")
+  worst other  the worst over the patches not near a triple tie
 """
 from __future__ import annotations
 
@@ -38,7 +41,7 @@ REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 
 from cltess.io.camera_path import orbit  # noqa: E402
-from cltess.patterns.fractional import to_fixed  # noqa: E402
+from cltess.patterns.fractional import FIXED_ONE, to_fixed  # noqa: E402
 from cltess.patterns.sd2 import sd2_shape  # noqa: E402
 from cltess.scene import Scene  # noqa: E402
 
@@ -236,6 +239,16 @@ def setting(scene) -> tuple[np.ndarray, float, tuple]:
     return (lo + hi) / 2, 3 * bound, (1.5 * bound, 4.5 * bound)
 
 
+def near_triple_tie(records: np.ndarray) -> np.ndarray:
+    """(P,) bool: the patch's three corner factors phi lie within one factor unit (the tie zone's
+    width) of each other: the largest factor less the hint's smallest phi (docs/sd2.md section 5,
+    "Triple ties"); without a hint, the largest factor less the smallest."""
+    f = records[:, :3].astype(np.int64)
+    hint = np.abs(records[:, 3].astype(np.int64))
+    smallest = np.where(hint > 0, hint >> 2, f.min(axis=1))
+    return (f[:, 0] > 0) & (f.max(axis=1) - smallest < FIXED_ONE)
+
+
 def frame_options(level_function: str, camera, low: float, high: float, band: float, depth_range, pixels: float):
     if level_function == "bound":  # the error bound at a screen-space tolerance of this frame's camera
         return dict(pixels=pixels, pattern="sd2", level_function="bound", max_factor=64)
@@ -261,6 +274,9 @@ def measure(tessellator, scene, sweep: float, steps: int, low: float, high: floa
             records.append(np.abs(plan.host_factors()))
             frames.append(tessellator.emit(plan, 0, plan.num_patches))
         measured = [distance(a, b, ra, rb) for a, b, ra, rb in zip(frames, frames[1:], records, records[1:])]
+        near = [near_triple_tie(ra) | near_triple_tie(rb) for ra, rb in zip(records, records[1:])]
+        others = np.array([np.where(n, 0.0, d).max() for (d, _), n in zip(measured, near)])
+        triple = sum(bool(n[np.argmax(d)]) and d.max() > 0 for (d, _), n in zip(measured, near))
         distances = [d for d, _ in measured]
         step_worst = np.array([d.max() for d in distances])
         median = float(np.median(step_worst))
@@ -268,7 +284,8 @@ def measure(tessellator, scene, sweep: float, steps: int, low: float, high: floa
         relaid = sum(changed for _, changed in measured)
         out[count] = {"step_deg": sweep / count, "worst": float(step_worst.max()), "median": median,
                       "jumps": int(np.count_nonzero(step_worst > 4 * median)), "tips": int(tips), "steps": count,
-                      "relaid": int(relaid), "triangles": int(np.mean([f.num_triangles for f in frames]))}
+                      "relaid": int(relaid), "triangles": int(np.mean([f.num_triangles for f in frames])),
+                      "triple": int(triple), "worst_other": float(others.max())}
     return out
 
 
@@ -298,10 +315,11 @@ def main(argv=None) -> int:
             + (f", band {args.band:g}" if args.level_function == "silhouette" else ""))
     print(f"{args.mesh} ({scene.num_triangles} faces), {what}, {args.sweep:g} degree orbit, {args.measure} "
           f"distance, device {tessellator.device.name.strip()}")
-    print(f"{'step deg':>9} {'worst':>9} {'median':>9} {'jumps':>6} {'tips':>5} {'relaid':>7} {'triangles':>10}")
+    print(f"{'step deg':>9} {'worst':>9} {'median':>9} {'jumps':>6} {'tips':>5} {'relaid':>7} {'triangles':>10}"
+          f" {'triple':>6} {'worst other':>11}")
     for row in result.values():
         print(f"{row['step_deg']:9.3f} {row['worst']:9.5f} {row['median']:9.5f} {row['jumps']:6d} {row['tips']:5d}"
-              f" {row['relaid']:7d} {row['triangles']:10d}")
+              f" {row['relaid']:7d} {row['triangles']:10d} {row['triple']:6d} {row['worst_other']:11.5f}")
     fine, coarse = result[2 * args.steps]["worst"], result[args.steps]["worst"]
     print(f"worst at half the step / worst at the step: {fine / coarse:.3f}")
     if args.json:

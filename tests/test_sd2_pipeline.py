@@ -145,48 +145,27 @@ def test_random_fractional_factors_are_watertight_without_t_junctions(tessellato
     assert shapes  # (the fallback, fans and grids all occur: the factors are random)
 
 
+@pytest.mark.parametrize("function", ["silhouette", "depth"])
+def test_level_functions_are_watertight(tessellator, function):
+    """The silhouette's ramp (and depth) on a closed mesh, in the tie zone and out: an edge's factor
+    comes from its two ends alone, so the mesh welds bitwise without T-junctions."""
+    scene = icosphere(2)
+    tess = tessellator.tessellate(scene, eps=1e-3, pattern="sd2", level_function=function, camera=CAMERA,
+                                  level_factors=(1.0, 7.0))
+    real = tess.real_factors[:, :3]
+    assert len(np.unique(real)) > 10  # ramps, not two classes
+    welded = tess.welded()
+    assert welded.stats["welded_boundary_edges"] == 0 and welded.stats["welded_nonmanifold_edges"] == 0
+    assert len(t_junctions(tess.positions, tess.triangles, tess.object_ids)) == 0
+    assert np.array_equal(expand_strips(tess.strips), tess.triangles)
+
+
 def test_bound_variant_keeps_the_bound(tessellator):
     for scene, eps in ((icosphere(2), 1e-3), (Scene.from_trimesh(torus(), name="torus"), 3e-3)):
         plan = tessellator.plan(scene, eps=eps, pattern="sd2", level_function="bound")
         tess = tessellator.emit(plan, 0, plan.num_patches)
         measured = tessellator.verify(scene, plan, tess)
         assert 0 < measured["verify_ratio"] <= 1.0, measured
-
-
-def surface_at(tess, samples: np.ndarray) -> np.ndarray:
-    """(P, S, 3) the mesh's points at domain points samples (S, 2) (u, v) of every patch: the
-    triangle of the patch's pattern holding each, interpolated linearly."""
-    tri = tess.triangles.astype(np.int64)
-    patch = tess.patch_ids[tri[:, 0]]
-    a, b, c = (tess.uv[tri[:, k]].astype(np.float64) for k in range(3))
-    e1, e2, q = b - a, c - a, samples[None, :, :] - a[:, None, :]
-    den = e1[:, 0] * e2[:, 1] - e2[:, 0] * e1[:, 1]
-    ok = np.abs(den) > 1e-12
-    den = np.where(ok, den, 1.0)[:, None]
-    l1 = (q[..., 0] * e2[:, None, 1] - e2[:, None, 0] * q[..., 1]) / den
-    l2 = (e1[:, None, 0] * q[..., 1] - q[..., 0] * e1[:, None, 1]) / den
-    l0 = 1 - l1 - l2
-    inside = ok[:, None] & (l0 >= -1e-5) & (l1 >= -1e-5) & (l2 >= -1e-5)
-    p = tess.positions.astype(np.float64)
-    at = l0[..., None] * p[tri[:, 0]][:, None] + l1[..., None] * p[tri[:, 1]][:, None] + l2[..., None] * p[tri[:, 2]][:, None]
-    out = np.full((patch.max() + 1, len(samples), 3), np.nan)
-    t, s = np.nonzero(inside)
-    out[patch[t], s] = at[t, s]
-    assert not np.isnan(out).any()
-    return out
-
-
-SAMPLES = np.array([(i / 7, j / 7) for i in range(8) for j in range(8 - i)]) * 0.9 + 0.03
-
-
-def frame_distances(a, b) -> np.ndarray:
-    """(P,) largest distance between two meshes at the same domain points of each patch (a bound
-    on their Hausdorff distance there)."""
-    return np.linalg.norm(surface_at(a, SAMPLES) - surface_at(b, SAMPLES), axis=2).max(axis=1)
-
-
-def shapes(tess):
-    return [sd2_shape(f) for f in to_fixed(tess.real_factors[:, :3])]
 
 
 def test_factors_move_with_the_step(tessellator):

@@ -112,6 +112,17 @@ def _fan_z(t: np.float32, s: np.float32, w: np.float32, lam: np.float32) -> np.f
     return f32(f32(w * radial) + f32(f32(one - w) * tie))
 
 
+def _centre_mu(w: np.float32, lam: np.float32) -> np.float32:
+    """How far a zone quad's centre has slid from its corner (i, j+1) towards (i, j):
+    ``(1 - w) max(1 - lam, w / 4)``.  (1 - w)(1 - lam) is the slide of docs/sd2.md section 5;
+    the floor w (1 - w) / 4, zero at the zone's two ends (w = 1: the radial pattern, w = 0: a
+    tie), keeps the centre off (i, j+1) inside the zone when lam = 1: the last column's (i, j+1)
+    is a ring point, whose position the ring evaluates, and a centre on it, evaluated as an
+    interior point, would differ in the last bits (a T-junction of an ulp).  Device: sd2.h."""
+    one = np.float32(1.0)
+    return np.float32(np.float32(one - w) * max(np.float32(one - lam), np.float32(np.float32(0.25) * w)))
+
+
 def _row_point(c: int, t: np.float32, z: np.float32) -> np.ndarray:
     """Barycentric point on the row at location t from corner c with corner c+2 weight z."""
     weights = np.zeros(3, np.float32)
@@ -213,7 +224,7 @@ def sd2_layout(f) -> tuple[np.ndarray, list[np.ndarray]]:
             w, lam = lay.w, lay.lam
             z = [[_fan_z(t[i], s[j], w, lam) for j in range(b + 1)] for i in range(a + 1)]
             uv += [_row_point(c, t[i], z[i][j])[:2] for i in range(1, a) for j in range(1, b)]
-            mu = np.float32(np.float32(1.0) - w) * np.float32(np.float32(1.0) - lam)
+            mu = _centre_mu(w, lam)
             keep = np.float32(1.0) - mu
             uv += [_row_point(c, t[i], np.float32(np.float32(keep * z[i][j + 1]) + np.float32(mu * z[i][j])))[:2]
                    for i in range(1, a) for j in range(b)]

@@ -186,10 +186,11 @@ inline float3 pattern_row_point(int4 f, int j, int i)
             float t = sd2_location(big, j);
             return sd2_row_point(tip, t, sd2_fan_z(t, sd2_location(base, i), w, lam));
         }
-        /* the centre of quad (r, i - 1), sliding on row r from (r, i) to (r, i - 1) by mu */
+        /* the centre of quad (r, i - 1), sliding on row r from (r, i) to (r, i - 1) by mu, kept
+         * off (r, i) inside the zone (mirror _centre_mu) */
         int r = j - (a - 1);
         float t = sd2_location(big, r);
-        float mu = (1.0f - w) * (1.0f - lam);
+        float mu = (1.0f - w) * fmax(1.0f - lam, 0.25f * w);
         float keep = 1.0f - mu;
         float right = keep * sd2_fan_z(t, sd2_location(base, i), w, lam);
         float left = mu * sd2_fan_z(t, sd2_location(base, i - 1), w, lam);
