@@ -31,8 +31,8 @@ DEPTH_MAPS = {"linear": 0, "quadratic": 1}
 #: Default (low, high) factors: the paper's silhouette refinement uses b = 7 (Tables 1-2).
 DEFAULT_LEVEL_FACTORS = (1.0, 7.0)
 #: Default width (in cosine) of the silhouette's ramp from high to low (docs/sd2.md section 2):
-#: about the turn of the normal across one edge of a coarse mesh (sphere-320: 0.32 rad), so the
-#: ramp spans about one ring of triangles; 0 gives the paper's classes (and pops).
+#: about the turn of the normal across one edge of a coarse mesh (sphere-320: 0.30 rad, the
+#: median), so the ramp spans about one ring of triangles; 0 gives the paper's classes (and pops).
 DEFAULT_SILHOUETTE_BAND = 0.25
 
 
