@@ -1,6 +1,7 @@
 """The structure of Tables 1-2 of Amresh and Fünfzig, "Semi-uniform, 2-different tessellation of
 triangular parametric surfaces" (/work/shared/SEEDS.md section 2.2) with cltess's SD-2 pattern:
-silhouette refinement with factor b = 7 on crossed edges and a on the others, on PN meshes of
+silhouette refinement with factor b = 7 on crossed edges and a on the others (the paper's
+classes: ``silhouette_band=0``; cltess's default ramp refines a band around them), on PN meshes of
 the paper's base sizes, against uniform factor 7 (exactly 49 x base) and the transition
 pattern (the paper's stitching [7]) on the same integer factors.
 
@@ -123,7 +124,7 @@ def measure(tessellator, scene: Scene, low: list[float], repeat: int) -> list[di
                      strip_bytes=None, list_bytes=12 * uniform.num_triangles, ms=ms, error=error))
     for a in low:
         options = dict(eps=1.0, pattern="sd2", level_function="silhouette", level_factors=(a, UNIFORM),
-                       max_factor=UNIFORM)
+                       max_factor=UNIFORM, silhouette_band=0.0)  # the paper's classes (docs/sd2.md 2)
         sd2, ms = median_run(lambda: tessellator.tessellate(scene, **options), repeat)
         plan = tessellator.plan(scene, **options)
         error = tessellator.verify(scene, plan, sd2)["verify_ratio"]

@@ -33,6 +33,7 @@ import warnings
 from pathlib import Path
 
 from cltess.io.export import MESH_FORMATS, SUPPORTED_EXTENSIONS, check_extension
+from cltess.levels import DEFAULT_SILHOUETTE_BAND
 from cltess.scene import DEFAULT_CREASE_ANGLE
 
 PROG = "cltess"
@@ -258,6 +259,10 @@ def build_parser() -> argparse.ArgumentParser:
                              "crossed edges (default 1 7)")
     shared.add_argument("--depth-map", choices=("linear", "quadratic"), default="linear",
                         help="sd2 depth: the paper's g1 (linear, default) or g2 (quadratic) map")
+    shared.add_argument("--silhouette-band", type=float, default=DEFAULT_SILHOUETTE_BAND, metavar="COS",
+                        help="sd2 silhouette: width (in cosine of the normal-view angle) of the ramp from the "
+                             "high factor at the silhouette to the low one, so factors change continuously "
+                             "with the view (default %(default)s); 0: the paper's classes, which pop")
     shared.add_argument("-q", "--quiet", action="store_true",
                         help="print nothing on success, no progress bar (warnings still go to stderr)")
 
@@ -727,7 +732,7 @@ def _level_options(args, scene) -> dict:
     if args.pattern != "sd2":
         return {"bound": "integral"} if args.bound == "integral" else {}
     return {"level_function": args.level_function, "level_factors": tuple(args.level_factors),
-            "depth_map": args.depth_map}
+            "depth_map": args.depth_map, "silhouette_band": args.silhouette_band}
 
 
 def _warn_saturated(saturated: int, args) -> None:

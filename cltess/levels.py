@@ -7,9 +7,11 @@ mirror of kernels/criteria/level.h (the device runs it: cltess/backends/opencl/l
   g1 (linear) or g2 (quadratic) mapping the depth range [near, far] (this frame's, unless
   given) onto [high, low].  With d0 <= d1 <= d2 at a triangle's corners its factors are
   g(d0), g(d0), g(d1): the equal pair meets at the nearest corner, the tip.
-* ``silhouette``: a vertex is front-facing when n . (eye - v) >= 0; an edge whose ends differ
-  is crossed and gets ``high`` (the paper's b), the others ``low`` (a): 0 or 2 crossed edges per
-  triangle, meeting at the odd corner.
+* ``silhouette``: the vertex's value is the cosine c(v) = n . (eye - v) / |eye - v|, front-facing
+  when >= 0; an edge whose ends differ is crossed and gets ``high`` (the paper's b), the others
+  the ramp ``psi(min(|c_s|, |c_e|))`` from ``high`` at 0 down to ``low`` (a) at the band width
+  (``silhouette_band``; 0: ``low``, the paper's classes): continuous in the view, and still 0 or
+  2 crossed edges per triangle meeting at the odd corner, so at most two different factors.
 * ``bound``: h(v) = the largest error-bound factor (stage 1's, rounded up to an odd whole
   number, which fractional_odd spaces evenly) of the edges at v; the edge takes max(h(s), h(e)),
   at least its own bound, so the error bound still holds; the equal pair meets at the corner
@@ -28,6 +30,10 @@ LEVEL_FUNCTIONS = {"depth": 1, "silhouette": 2, "bound": 3}
 DEPTH_MAPS = {"linear": 0, "quadratic": 1}
 #: Default (low, high) factors: the paper's silhouette refinement uses b = 7 (Tables 1-2).
 DEFAULT_LEVEL_FACTORS = (1.0, 7.0)
+#: Default width (in cosine) of the silhouette's ramp from high to low (docs/sd2.md section 2):
+#: about the turn of the normal across one edge of a coarse mesh (sphere-320: 0.30 rad, the
+#: median), so the ramp spans about one ring of triangles; 0 gives the paper's classes (and pops).
+DEFAULT_SILHOUETTE_BAND = 0.25
 
 
 def welded_corners(scene) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -62,13 +68,27 @@ def camera_frame(camera: Camera) -> tuple[np.ndarray, np.ndarray]:
 # --- the NumPy mirror of kernels/criteria/level.h ------------------------------------------------
 
 def vertex_levels(function: str, positions, normals, camera: Camera) -> np.ndarray:
-    """(W,) float32 values of the welded vertices: depth or silhouette class (1 front, 0 back)."""
+    """(W,) float32 values of the welded vertices: depth, or the silhouette's cosine
+    n . (eye - v) / |eye - v| (its sign the paper's class: >= 0 front)."""
     eye, forward = camera_frame(camera)
     positions = np.asarray(positions, np.float32)
     if function == "depth":
         return ((positions - eye) * forward).sum(axis=1, dtype=np.float32)
-    facing = (np.asarray(normals, np.float32) * (eye - positions)).sum(axis=1, dtype=np.float32)
-    return (facing >= 0).astype(np.float32)
+    view = eye - positions
+    length = np.sqrt((view * view).sum(axis=1, dtype=np.float32))
+    facing = (np.asarray(normals, np.float32) * view).sum(axis=1, dtype=np.float32)
+    return np.where(length > 0, facing / np.where(length > 0, length, 1), 0).astype(np.float32)
+
+
+def silhouette_ramp(x, band: float, low: float, high: float) -> np.ndarray:
+    """psi: the silhouette's factor at cosine distance x from it, high at 0 falling linearly to low
+    at the band (float32, the device's operations); band 0: low everywhere (the paper's classes)."""
+    x = np.asarray(x, np.float32)
+    f32 = np.float32
+    if band <= 0:
+        return np.full(x.shape, f32(low))
+    ramp = f32(high) - f32(f32(high) - f32(low)) * (x / f32(band))
+    return np.where(x < f32(band), ramp, f32(low)).astype(np.float32)
 
 
 def depth_factor(d, depth_map: str, near: float, far: float, low: float, high: float) -> np.ndarray:
@@ -93,11 +113,17 @@ def vertex_bounds(corners, factors) -> np.ndarray:
     return bounds
 
 
+def _fixed(r) -> np.ndarray:
+    """kernels/criteria/level.h fixed_factor of float32 factors r: 16.16, at least 1.0."""
+    scaled = np.asarray(r, np.float32) * np.float32(FIXED_ONE)
+    return np.maximum(np.rint(scaled), FIXED_ONE).astype(np.int64)
+
+
 def level_factors(function: str, corners, values, depth_map: str = "linear", near: float = 0.0,
-                  far: float = 1.0, low: float = 1.0, high: float = 7.0) -> np.ndarray:
+                  far: float = 1.0, low: float = 1.0, high: float = 7.0, band: float = 0.0) -> np.ndarray:
     """(T, 3) fixed-point edge factors (edge e from corner e to e+1) from the corners' values
     (levels, or ``vertex_bounds`` for "bound"); float64, so equal to the device's within a
-    float32 rounding of the depth map."""
+    float32 rounding of the depth map.  ``band``: the silhouette's ramp width (cosine)."""
     corners = np.asarray(corners, np.int64)
     values = np.asarray(values, np.float64)
     a, b = values[corners], values[np.roll(corners, -1, axis=1)]
@@ -105,15 +131,19 @@ def level_factors(function: str, corners, values, depth_map: str = "linear", nea
         g = lambda d: np.maximum(np.rint(depth_factor(d, depth_map, near, far, low, high) * FIXED_ONE), FIXED_ONE)
         return np.maximum(g(a), g(b)).astype(np.int64)
     if function == "silhouette":
-        return np.where(a != b, round(high * FIXED_ONE), round(low * FIXED_ONE)).astype(np.int64)
+        crossed = (a >= 0) != (b >= 0)
+        plain = silhouette_ramp(np.minimum(np.abs(a), np.abs(b)), band, low, high)
+        return _fixed(np.where(crossed, np.float32(high), plain))
     return (np.maximum(a, b) * FIXED_ONE).astype(np.int64)
 
 
 def level_hints(function: str, corners, values, depth_map: str = "linear", near: float = 0.0,
-                far: float = 1.0, low: float = 1.0, high: float = 7.0) -> np.ndarray:
+                far: float = 1.0, low: float = 1.0, high: float = 7.0, band: float = 0.0) -> np.ndarray:
     """(T,) the SD-2 pattern's hint per triangle (kernels/criteria/level.h level_hint,
     cltess/patterns/sd2.py sd2_hint): ``(phi_m << 2) | m``, m the first corner of the smallest
-    per-vertex factor phi (depth: g of its depth, bound: its bound), 0 for the silhouette."""
+    per-corner factor phi, every edge's factor being the larger of its ends' phi (depth: g of its
+    depth; bound: its bound; silhouette: high at the triangle's odd corner, else the ramp of its
+    own |cosine|)."""
     from .patterns.sd2 import HINT_SHIFT
     corners = np.asarray(corners, np.int64)
     values = np.asarray(values, np.float64)[corners]
@@ -122,7 +152,9 @@ def level_hints(function: str, corners, values, depth_map: str = "linear", near:
     elif function == "bound":
         phi = values * FIXED_ONE
     else:
-        return np.zeros(len(corners), np.int64)
+        front = values >= 0
+        odd = (front != np.roll(front, -1, axis=1)) & (front != np.roll(front, -2, axis=1))
+        phi = _fixed(np.where(odd, np.float32(high), silhouette_ramp(np.abs(values), band, low, high)))
     phi = phi.astype(np.int64)
     m = np.argmin(phi, axis=1)
     smallest = phi[np.arange(len(phi)), m]
@@ -146,9 +178,10 @@ def reference_level_factors(scene, request, stage1: np.ndarray) -> tuple[np.ndar
             near, far = request.depth_range if request.depth_range is not None else \
                 (float(values.min()), float(values.max()))
             stats["depth_range"] = (near, far)
-    fixed = level_factors(function, corners, values, request.depth_map, near, far, low, high)
+    band = request.silhouette_band
+    fixed = level_factors(function, corners, values, request.depth_map, near, far, low, high, band)
     out = np.zeros((len(corners), 4), np.int64)
     live = np.asarray(stage1)[:, 0] > 0
     out[live, :3] = fixed[live]
-    out[live, 3] = level_hints(function, corners, values, request.depth_map, near, far, low, high)[live]
+    out[live, 3] = level_hints(function, corners, values, request.depth_map, near, far, low, high, band)[live]
     return out.astype(np.int32), stats

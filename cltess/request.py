@@ -23,7 +23,7 @@ BOUNDS = ("hull", "integral")
 #: Request.emit's values: stages 4-5 per patch, or by level (cltess/backends/opencl/levels.py).
 EMIT_MODES = ("per_patch", "by_level")
 from .scene import Camera, Scene
-from .levels import DEFAULT_LEVEL_FACTORS, DEPTH_MAPS, LEVEL_FUNCTIONS
+from .levels import DEFAULT_LEVEL_FACTORS, DEFAULT_SILHOUETTE_BAND, DEPTH_MAPS, LEVEL_FUNCTIONS
 
 
 @dataclass(frozen=True)
@@ -52,6 +52,9 @@ class Request:
                     crossed edges), within 1 .. max_factor.
     depth_map:      "linear" (g1) or "quadratic" (g2) for "depth".
     depth_range:    (near, far) depths mapped onto (high, low); None: this frame's range.
+    silhouette_band: "silhouette": the width, in cosine of the angle between normal and view, of
+                    the ramp from high (at the silhouette) to low; continuous in the view for
+                    band > 0 (default 0.25), the paper's two classes (which pop) for 0.
     camera:         the camera of "depth" and "silhouette" (None: the scene's).
     bound:          "hull" (stage 1's factors) or "integral": rational Bézier patches try smaller
                     factors, each emitted triangle bounded by the integral form of the remainder
@@ -71,6 +74,7 @@ class Request:
     depth_range: tuple | None = None
     camera: Camera | None = None
     bound: str = "hull"
+    silhouette_band: float = DEFAULT_SILHOUETTE_BAND
 
     def __post_init__(self):
         value = self.tolerance.eps if isinstance(self.tolerance, ObjectSpace) else self.tolerance.pixels
@@ -109,6 +113,8 @@ class Request:
         if self.bound == "integral" and (self.level_function is not None or self.pattern not in (None, "transition", "quad_transition")):
             raise ValueError(f"bound 'integral' scales the transition pattern's factors; it cannot be used with "
                              f"pattern {self.pattern or 'sd2'!r}")
+        if not (isinstance(self.silhouette_band, numbers.Real) and 0 <= self.silhouette_band <= 2):
+            raise ValueError(f"silhouette_band must be a number in 0..2 (a cosine range), got {self.silhouette_band!r}")
         if self.camera is not None and not isinstance(self.camera, Camera):
             raise ValueError(f"camera must be a cltess.scene.Camera, got {type(self.camera).__name__}")
 

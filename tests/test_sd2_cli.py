@@ -36,10 +36,14 @@ def test_level_function_from_a_json_scenes_camera(tmp_path, mesh_file):
                                  "camera": {"eye": [3, 1, 0.5], "target": [0, 0, 0]}}))
     out = tmp_path / "out.npz"
     code = main(["tessellate", str(scene), "-o", str(out), "--eps", "1e-3", "--level-function", "silhouette",
-                 "--level-factors", "2", "6", "-q"])
+                 "--level-factors", "2", "6", "--silhouette-band", "0", "-q"])
     assert code == 0
     real = load_npz(out).real_factors[:, :3]
-    assert set(np.unique(real)) == {2.0, 6.0}
+    assert set(np.unique(real)) == {2.0, 6.0}  # band 0: the paper's classes
+    code = main(["tessellate", str(scene), "-o", str(out), "--eps", "1e-3", "--level-function", "silhouette",
+                 "--level-factors", "2", "6", "-q"])
+    real = load_npz(out).real_factors[:, :3]
+    assert code == 0 and real.min() >= 2.0 and real.max() == 6.0 and len(np.unique(real)) > 2  # the ramp
 
 
 def test_level_function_without_camera_is_a_clear_error(tmp_path, mesh_file, capsys):
@@ -58,6 +62,8 @@ def test_level_function_without_camera_is_a_clear_error(tmp_path, mesh_file, cap
     (dict(depth_map="cubic"), "depth_map"),
     (dict(depth_range=(2, 1)), "depth_range"),
     (dict(camera="front"), "camera"),
+    (dict(silhouette_band=-0.1), "silhouette_band"),
+    (dict(silhouette_band="wide"), "silhouette_band"),
 ])
 def test_bad_level_options_are_refused(options, fragment):
     with pytest.raises(ValueError, match=fragment):

@@ -137,3 +137,90 @@ def test_tie_configuration_is_the_same_from_both_sides():
                 nearest = np.min([np.abs(one[:, None, list(p)] - other[None]).max(axis=(2, 3))
                                   for p in itertools.permutations(range(3))], axis=0).min(axis=1)
                 assert nearest.max() < 1e-4, (h, x, y, nearest.max())
+
+
+def same_surface(one_record, other_record, tolerance=1e-4) -> float:
+    """The largest distance (in the domain) from a non-degenerate triangle of one record's pattern to
+    the nearest of the other's (as corner positions, any order); inf when their numbers differ."""
+    def surface(record):
+        uv, triangles = sd2_pattern(record)
+        return uv[triangles[signed_areas(uv, triangles) > 2e-4]]  # (T, 3, 2)
+
+    one, other = surface(one_record), surface(other_record)
+    if len(one) != len(other):
+        return np.inf
+    return float(np.min([np.abs(one[:, None, list(p)] - other[None]).max(axis=(2, 3))
+                         for p in itertools.permutations(range(3))], axis=0).min(axis=1).max())
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.sampled_from([1, 3, 5, 7, 9]), st.integers(0, 2), st.integers(1, 64), st.integers(0, 2))
+def test_leaving_a_plateau_at_an_odd_factor_is_continuous(n, corner, delta, stay):
+    """A triple tie that lasts (a level function clamped at low or high: every corner's phi the
+    same odd whole n) left by one corner rising delta 16.16 units above it, or by two: the fans
+    that follow (in the tie zone, base corners tied with each other: lam = 1, docs/sd2.md section
+    5) start from the plateau's grid, whichever corner rises (at odd whole factors every tie
+    configuration is the regular lattice).  Before: lam was 1/2 there, a blend of two tie
+    configurations that no grid has."""
+    plateau = n * FIXED_ONE
+    phi = [plateau] * 3
+    phi[corner] += delta
+    if stay == 1:  # a second corner rising less
+        phi[(corner + 1) % 3] += delta // 2
+    grid = hinted_record([plateau] * 3)
+    assert sd2_shape(grid)[0] == "grid"
+    assert same_surface(hinted_record(phi), grid) < 1e-3, (n, corner, delta, phi)
+    check_pattern(hinted_record(phi), fold_tolerance=1e-7)
+
+
+def silhouette_record(cosines, high, band=0.25, low=1.0) -> list:
+    """The record the silhouette level function makes for one triangle with these corner cosines
+    (cltess/levels.py, the mirror of kernels/criteria/level.h): three factors and the hint."""
+    from cltess.levels import level_factors, level_hints
+    corners = np.array([[0, 1, 2]])
+    values = np.asarray(cosines, np.float32)
+    factors = level_factors("silhouette", corners, values, low=low, high=high, band=band)[0]
+    return [int(x) for x in factors] + [int(level_hints("silhouette", corners, values, low=low, high=high,
+                                                           band=band)[0])]
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2), st.floats(0.01, 1.0), st.floats(0.01, 1.0), st.sampled_from([3.0, 5.0, 7.0]),
+       st.booleans(), st.booleans())
+def test_silhouette_passing_a_vertex_is_continuous(corner, behind, ahead, high, flip, negate):
+    """Where the silhouette passes a mesh vertex (its cosine changes sign between two others of
+    opposite signs) the triangle's odd corner, and so its tip, changes: just before and just after,
+    all three edges are within 16.16 units of the high factor, in the tie zone, and their fans are
+    the same surface when high is an odd whole number (every tie configuration is then the
+    regular lattice; docs/sd2.md section 2).  Before the ramp (the paper's classes) the factors
+    jumped here between a and b."""
+    others = [(corner + 1) % 3, (corner + 2) % 3]
+    if flip:
+        others.reverse()
+    sign = -1.0 if negate else 1.0
+    cosines = [0.0, 0.0, 0.0]
+    cosines[others[0]], cosines[others[1]] = -sign * behind, sign * ahead
+    before, after = list(cosines), list(cosines)
+    before[corner], after[corner] = sign * 1e-6, -sign * 1e-6
+    one, other = silhouette_record(before, high), silhouette_record(after, high)
+    assert sd2_shape(one)[1] != sd2_shape(other)[1] or sd2_shape(one)[0] == "grid"  # the tip moves
+    assert same_surface(one, other) < 1e-3, (one, other)
+    check_pattern(one, fold_tolerance=1e-7)
+    check_pattern(other, fold_tolerance=1e-7)
+
+
+def test_silhouette_ramp_is_continuous_and_the_classes_are_its_limit():
+    """The silhouette's factors move continuously as one corner's cosine crosses zero or the band's
+    edge (no jump larger than the cosine's change times (high - low) / band), and with band 0 they
+    are the paper's classes: high on crossed edges, low elsewhere."""
+    low, high, band = 1.0, 7.0, 0.25
+    slope = (high - low) / band
+    for others in ([-0.4, 0.6], [0.3, 0.05], [-0.2, -0.7]):
+        records = [silhouette_record([x] + others, high, band, low) for x in np.linspace(-0.5, 0.5, 2001)]
+        steps = np.abs(np.diff(np.array(records)[:, :3], axis=0)) / FIXED_ONE
+        assert steps.max() <= slope * 0.0005 + 2 / FIXED_ONE, others
+    for cosines in ([-0.4, 0.6, 0.1], [0.3, 0.05, 0.9], [-0.2, -0.7, -0.01], [0.0, -0.1, 0.2]):
+        front = np.array(cosines) >= 0
+        crossed = [front[e] != front[(e + 1) % 3] for e in range(3)]
+        expected = [round((high if x else low) * FIXED_ONE) for x in crossed]
+        assert silhouette_record(cosines, high, band=0.0, low=low)[:3] == expected, cosines

@@ -80,8 +80,11 @@ def sd2_morph(f, c: int) -> tuple[bool, np.float32, np.float32]:
     """(in the tie zone, w, lam) of the fan with tip c (docs/sd2.md section 5).  w: the radial
     pattern's weight, ``(F - G) / 1.0`` (F the tip edges' factor, G the base's): 0 at a tie, the
     zone is w < 1.  lam: the weight of the tie configuration with partner c+1 against partner
-    c+2, ``e2 / (e1 + e2)``, e_k = F - phi_k the distance of base corner k from tying with the
-    tip (1/2 at a triple tie).  Outside the zone, or without a usable hint: (False, 1, 1)."""
+    c+2, ``min(e2 / e1, 1)``, e_k = F - phi_k the distance of base corner k from tying with the
+    tip: 1 at e1 = 0, 0 at e2 = 0, continuous elsewhere, and 1 when the base corners tie with each
+    other (e1 = e2: a plateau left by the tip starts from the tie configuration with partner c+1,
+    which at an odd whole factor is the plateau's grid).  Outside the zone, or without a usable
+    hint: (False, 1, 1)."""
     one = np.float32(1.0)
     hint = sd2_hint(f)
     big, base = int(f[c]), int(f[(c + 1) % 3])
@@ -91,7 +94,7 @@ def sd2_morph(f, c: int) -> tuple[bool, np.float32, np.float32]:
     e_m, e_other = big - phi_m, big - base
     e1, e2 = (e_m, e_other) if m == (c + 1) % 3 else (e_other, e_m)
     w = np.float32(e_other) * np.float32(1.0 / FIXED_ONE)
-    lam = np.float32(e2) / np.float32(e1 + e2) if e1 + e2 > 0 else np.float32(0.5)
+    lam = min(np.float32(np.float32(e2) / np.float32(e1)), np.float32(1.0)) if e1 > 0 else np.float32(1.0)
     return True, w, lam
 
 
@@ -107,6 +110,17 @@ def _fan_z(t: np.float32, s: np.float32, w: np.float32, lam: np.float32) -> np.f
     towards_2 = min(s, t)
     tie = f32(f32(lam * towards_1) + f32(f32(one - lam) * towards_2))
     return f32(f32(w * radial) + f32(f32(one - w) * tie))
+
+
+def _centre_mu(w: np.float32, lam: np.float32) -> np.float32:
+    """How far a zone quad's centre has slid from its corner (i, j+1) towards (i, j):
+    ``(1 - w) max(1 - lam, w / 4)``.  (1 - w)(1 - lam) is the slide of docs/sd2.md section 5;
+    the floor w (1 - w) / 4, zero at the zone's two ends (w = 1: the radial pattern, w = 0: a
+    tie), keeps the centre off (i, j+1) inside the zone when lam = 1: the last column's (i, j+1)
+    is a ring point, whose position the ring evaluates, and a centre on it, evaluated as an
+    interior point, would differ in the last bits (a T-junction of an ulp).  Device: sd2.h."""
+    one = np.float32(1.0)
+    return np.float32(np.float32(one - w) * max(np.float32(one - lam), np.float32(np.float32(0.25) * w)))
 
 
 def _row_point(c: int, t: np.float32, z: np.float32) -> np.ndarray:
@@ -210,7 +224,7 @@ def sd2_layout(f) -> tuple[np.ndarray, list[np.ndarray]]:
             w, lam = lay.w, lay.lam
             z = [[_fan_z(t[i], s[j], w, lam) for j in range(b + 1)] for i in range(a + 1)]
             uv += [_row_point(c, t[i], z[i][j])[:2] for i in range(1, a) for j in range(1, b)]
-            mu = np.float32(np.float32(1.0) - w) * np.float32(np.float32(1.0) - lam)
+            mu = _centre_mu(w, lam)
             keep = np.float32(1.0) - mu
             uv += [_row_point(c, t[i], np.float32(np.float32(keep * z[i][j + 1]) + np.float32(mu * z[i][j])))[:2]
                    for i in range(1, a) for j in range(b)]

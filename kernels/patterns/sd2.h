@@ -75,7 +75,8 @@ inline int sd2_hint(int4 f, int *m, int *phi)
 
 /* The tie zone of the fan with tip c (mirror sd2_morph): 1 when in it, with *w the radial
  * pattern's weight (F - G) / 1.0 and *lam the weight of the tie with partner c+1,
- * e2 / (e1 + e2), e_k = F - phi_k. */
+ * min(e2 / e1, 1), e_k = F - phi_k (1 when the base corners tie with each other: a plateau left
+ * by the tip starts from one tie configuration, docs/sd2.md section 5). */
 inline int sd2_morph(int4 f, int c, float *w, float *lam)
 {
     int m, phi_m;
@@ -87,7 +88,7 @@ inline int sd2_morph(int4 f, int c, float *w, float *lam)
     int e_m = big - phi_m, e_other = big - base;
     int e1 = m == (c + 1) % 3 ? e_m : e_other, e2 = m == (c + 1) % 3 ? e_other : e_m;
     *w = (float)e_other * (1.0f / (float)FIXED_ONE);
-    *lam = e1 + e2 > 0 ? (float)e2 / (float)(e1 + e2) : 0.5f;
+    *lam = e1 > 0 ? fmin((float)e2 / (float)e1, 1.0f) : 1.0f;
     return 1;
 }
 
@@ -185,10 +186,11 @@ inline float3 pattern_row_point(int4 f, int j, int i)
             float t = sd2_location(big, j);
             return sd2_row_point(tip, t, sd2_fan_z(t, sd2_location(base, i), w, lam));
         }
-        /* the centre of quad (r, i - 1), sliding on row r from (r, i) to (r, i - 1) by mu */
+        /* the centre of quad (r, i - 1), sliding on row r from (r, i) to (r, i - 1) by mu, kept
+         * off (r, i) inside the zone (mirror _centre_mu) */
         int r = j - (a - 1);
         float t = sd2_location(big, r);
-        float mu = (1.0f - w) * (1.0f - lam);
+        float mu = (1.0f - w) * fmax(1.0f - lam, 0.25f * w);
         float keep = 1.0f - mu;
         float right = keep * sd2_fan_z(t, sd2_location(base, i), w, lam);
         float left = mu * sd2_fan_z(t, sd2_location(base, i - 1), w, lam);

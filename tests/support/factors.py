@@ -55,6 +55,8 @@ def random_fixed_factors(rng, count, high=40):
         top = int(rng.integers(FIXED_ONE, high * FIXED_ONE))
         phi = [top, max(top - int(rng.choice([0, rng.integers(0, FIXED_ONE), rng.integers(0, 3 * FIXED_ONE)])), FIXED_ONE),
                max(top - int(rng.integers(0, 4 * FIXED_ONE)), FIXED_ONE)]
+        if rng.random() < 0.3:  # the base corners tied with each other (a plateau left by the tip)
+            phi[2] = phi[1]
         phi = [phi[k] for k in rng.permutation(3)]
         m = int(np.argmin(phi))
         factors[p] = [max(phi[e], phi[(e + 1) % 3]) for e in range(3)] + [(phi[m] << HINT_SHIFT) | m]

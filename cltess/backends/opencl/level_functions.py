@@ -1,7 +1,7 @@
 """The SD-2 level functions on the device (kernels/criteria/level.h; host side and NumPy mirror:
 cltess/levels.py), run between stage 1 and stage 2 for the patches of a fixed-point pattern:
 
-    vertex_levels   one work-item per welded vertex: depth to the eye plane or silhouette class
+    vertex_levels   one work-item per welded vertex: depth to the eye plane or silhouette cosine
                     (the depth range: pyopencl.array's min and max, unless the request gives it)
     vertex_bounds   the bound-keeping variant: per welded vertex the largest (odd-rounded)
                     stage-1 factor of its edges, by atomic max
@@ -70,6 +70,8 @@ def level_factors(tessellator, scene, request, part, factors) -> tuple[list, dic
         events.append(programs.kernel("vertex_bounds")(
             queue, _global_size(count), None, factors.data, corners.data, np.uint32(count),
             np.uint32(part.base), bounds.data))
+    if function == "silhouette":  # criteria/level.h: range = (band, -, low, high)
+        near = float(request.silhouette_band)
     range_args = np.array([near, far, low, high], np.float32)
     events.append(programs.kernel("level_factors")(
         queue, _global_size(count), None, corners.data, levels.data, bounds.data, np.uint32(count),
