@@ -39,33 +39,9 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from occ_compare import diagonal, random_rational_patches  # noqa: E402
 
-from cltess.criteria.zheng_sederberg import (CUBIC_DERIVATIVE, _bernstein_product, zs_constant_steps,  # noqa: E402
-                                             zs_constants)
+from cltess.criteria.integral import numerator_nets  # noqa: E402  (the engine's since issue 9, session 3)
+from cltess.criteria.zheng_sederberg import zs_constant_steps, zs_constants  # noqa: E402
 from cltess.surfaces.bezier import surface_points  # noqa: E402
-
-
-def numerator_nets(patch: np.ndarray):
-    """((10, 10, 3, 3) N_ab nets [j, i, which, xyz], (10, 10) w^3 net), plain Bernstein basis
-    (zheng_sederberg.second_derivative_hull before its division)."""
-    w = patch[..., 3:]
-    points = patch[..., :3] / w
-    centre = (points.min(axis=(0, 1)) + points.max(axis=(0, 1))) / 2
-    h = np.concatenate([patch[..., :3] - w * centre, w], axis=-1)
-    d_u = lambda a: np.einsum("ki,jic->jkc", CUBIC_DERIVATIVE, a)  # noqa: E731
-    d_v = lambda a: np.einsum("kj,jic->kic", CUBIC_DERIVATIVE, a)  # noqa: E731
-    h_u, h_v = d_u(h), d_v(h)
-
-    def wedge(a, b):
-        return _bernstein_product(a[..., 3:], b[..., :3]) - _bernstein_product(b[..., 3:], a[..., :3])
-
-    def scaled(a, b):
-        return _bernstein_product(a[..., 3:], b)
-
-    b_u, b_v = wedge(h, h_u), wedge(h, h_v)
-    numerators = (scaled(h, wedge(h, d_u(h_u))) - 2 * scaled(h_u, b_u),
-                  scaled(h, wedge(h, d_v(h_u))) - scaled(h_u, b_v) - scaled(h_v, b_u),
-                  scaled(h, wedge(h, d_v(h_v))) - 2 * scaled(h_v, b_v))
-    return np.stack(numerators, axis=2), scaled(h, scaled(h, h[..., 3:]))[..., 0]
 
 
 def halve(nets: np.ndarray, axis: int) -> np.ndarray:
