@@ -13,6 +13,14 @@ def tessellator():
     return Tessellator()
 
 
+@pytest.fixture(scope="session")
+def tea_table():
+    """The paper's tea table scene (scenes/tea_table.json), with its camera."""
+    from cltess.io import load_scene
+    from support import SCENES
+    return load_scene(SCENES / "tea_table.json")
+
+
 @pytest.fixture
 def rng(request):
     return np.random.default_rng(zlib.crc32(request.node.name.encode()))

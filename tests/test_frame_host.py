@@ -2,7 +2,6 @@
 their first launch (programs.Kernel), the kernel look-up by identity, stage 3 in one launch
 on CPUs for small scenes, a Session that skips the program look-up for a new camera alone,
 and frames that do not wait for their stages (Session.tessellate(wait=False))."""
-from pathlib import Path
 
 import numpy as np
 import pyopencl as cl
@@ -11,11 +10,10 @@ import pytest
 import cltess
 from cltess.backends.opencl import tessellator as opencl
 from cltess.backends.opencl.programs import Kernel
-from cltess.io import load_scene
 from cltess.scene import Camera
 from cltess.tessellation import HOST_FIELDS, StaleOutput
+from support import assert_same_output
 
-SCENES = Path(__file__).resolve().parent.parent / "scenes"
 
 ECHO = """
 __kernel void echo(__global uint *u, __global int *i, __global ulong *l, __global float *f, __global float4 *v,
@@ -24,16 +22,6 @@ __kernel void echo(__global uint *u, __global int *i, __global ulong *l, __globa
     u[0] = a; i[0] = b; l[0] = c; f[0] = d; v[0] = e;
 }
 """
-
-
-@pytest.fixture(scope="module")
-def tea_table():
-    return load_scene(SCENES / "tea_table.json")
-
-
-def assert_same(a, b):
-    for name in HOST_FIELDS:
-        assert np.array_equal(getattr(a, name), getattr(b, name)), name
 
 
 def test_kernel_packs_each_launch_by_its_first_launchs_types(tessellator, rng):
@@ -105,7 +93,7 @@ def test_new_cameras_and_tolerances_each_give_their_own_frame(tessellator, tea_t
     for name, options in frames:
         frame = session.tessellate(**options)
         request = session.request_for(**options)
-        assert_same(frame, tessellator.tessellate(tea_table, request=request))
+        assert_same_output(frame, tessellator.tessellate(tea_table, request=request))
         counts[name] = frame.num_triangles
     assert counts["far"] == counts["far again"] and counts["near"] == counts["near again"]
     assert len({counts["far"], counts["near"], counts["eps"], counts["coarser"]}) == 4
@@ -117,7 +105,7 @@ def test_a_new_work_distribution_mid_session(tessellator, tea_table):
     first = session.tessellate(camera=tea_table.camera).fetch()
     for work in ("point-prep", "patch"):
         own.work = work
-        assert_same(session.tessellate(camera=tea_table.camera), first)
+        assert_same_output(session.tessellate(camera=tea_table.camera), first)
 
 
 def test_frames_that_do_not_wait(tessellator, tea_table):
@@ -154,11 +142,11 @@ def test_a_cpu_devices_output_is_one_allocation_mapped_once(tessellator, tea_tab
     parent = session.output._parent
     align = max(1, tessellator.device.mem_base_addr_align // 8)
     assert all(buffer.offset % align == 0 and buffer.size >= 1 for buffer, _ in session.output._buffers.values())
-    assert_same(coarse, tessellator.tessellate(tea_table, eps=0.02))
+    assert_same_output(coarse, tessellator.tessellate(tea_table, eps=0.02))
     fine = session.tessellate(eps=0.002)  # more output: one new allocation for every field
     assert session.output._parent is not parent and session.output.nbytes > parent.size
-    assert_same(fine, tessellator.tessellate(tea_table, eps=0.002))
+    assert_same_output(fine, tessellator.tessellate(tea_table, eps=0.002))
     assert len(session.output._maps) == 1  # the fetch mapped once
     again = session.tessellate(eps=0.02)  # fewer: the same allocation
     assert session.output._parent.size == session.output.nbytes
-    assert_same(again, tessellator.tessellate(tea_table, eps=0.02))
+    assert_same_output(again, tessellator.tessellate(tea_table, eps=0.02))

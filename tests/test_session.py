@@ -1,26 +1,13 @@
 """Output that stays on the device (Tessellation.device, lazy host arrays), the frame loop
 (cltess.Session) and the wall-clock figures a result carries (issue 15)."""
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import cltess
-from cltess.io import load_scene
 from cltess.scene import Camera
-from cltess.tessellation import HOST_FIELDS, StaleOutput
-
-SCENES = Path(__file__).resolve().parent.parent / "scenes"
-
-
-@pytest.fixture(scope="module")
-def tea_table():
-    return load_scene(SCENES / "tea_table.json")
-
-
-def assert_same(a, b):
-    for name in HOST_FIELDS:
-        assert np.array_equal(getattr(a, name), getattr(b, name)), name
+from cltess.tessellation import StaleOutput
+from support import assert_same_output
 
 
 def orbit(scene, count):
@@ -54,7 +41,7 @@ def test_output_on_the_device_is_read_back_only_when_asked(tessellator, tea_tabl
     assert not tess.on_host
     assert np.array_equal(tess.positions, positions)  # the first host field fetches them all
     assert tess.on_host and tess.wall_ms["total"] >= tess.wall_ms["stages"]
-    assert_same(tess, tessellator.tessellate(tea_table, pixels=0.5))
+    assert_same_output(tess, tessellator.tessellate(tea_table, pixels=0.5))
 
 
 def test_batches_on_the_device_number_vertices_globally(tessellator, tea_table):
@@ -71,7 +58,7 @@ def test_session_frames_are_bitwise_the_one_shot_results(tessellator, tea_table)
     for camera in orbit(tea_table, 4):
         frame = session.tessellate(camera=camera)
         expected = tessellator.tessellate(tea_table, request=session.request_for(camera))
-        assert_same(frame, expected)
+        assert_same_output(frame, expected)
     assert session.frames == 4
 
 
@@ -82,16 +69,16 @@ def test_session_overrides_and_growing_buffers(tessellator, tea_table):
     fine = session.tessellate(eps=0.002)  # more output: the buffers grow
     grown = session.output.nbytes
     assert grown > size
-    assert_same(fine, tessellator.tessellate(tea_table, eps=0.002))
+    assert_same_output(fine, tessellator.tessellate(tea_table, eps=0.002))
     with pytest.raises(StaleOutput):
         coarse.fetch()
     with pytest.raises(StaleOutput):
         coarse.device.positions
     again = session.tessellate(eps=0.02)  # fewer: the same buffers
     assert session.output.nbytes == grown
-    assert_same(again, tessellator.tessellate(tea_table, eps=0.02))
+    assert_same_output(again, tessellator.tessellate(tea_table, eps=0.02))
     semi = session.tessellate(eps=0.02, pattern="semi_uniform")
-    assert_same(semi, tessellator.tessellate(tea_table, eps=0.02, pattern="semi_uniform"))
+    assert_same_output(semi, tessellator.tessellate(tea_table, eps=0.02, pattern="semi_uniform"))
 
 
 def test_session_refuses_what_it_cannot_do(tessellator, tea_table):

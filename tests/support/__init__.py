@@ -208,3 +208,11 @@ def translated_scene(path, offset: float):
     patches[..., :3] = (points + offset) * patches[..., 3:]
     return (Scene(patches, base.object_ids, name=f"{Path(path).name} + {offset:g}"),
             float(np.linalg.norm(np.ptp(points.reshape(-1, 3), axis=0))))
+
+
+def assert_same_output(a, b) -> None:
+    """Two tessellations' host arrays (cltess.tessellation.HOST_FIELDS) are bitwise equal."""
+    from cltess.tessellation import HOST_FIELDS
+
+    for name in HOST_FIELDS:
+        assert np.array_equal(getattr(a, name), getattr(b, name)), name
