@@ -481,6 +481,21 @@ inline void esc_walk(int4 f, int collapsed, __private esc_writer *w)
         esc_coarse_triangle(&g, t, w);
 }
 
+/* Coarse triangle t of record r: its corners and its sides' candidate bits (esc_coarse), and its
+ * row among its level's rows of the tables (esc.py count_table: side 0's bits lowest). */
+inline uint esc_table_row(__private const esc_record *r, int t, __private int2 corner[3], __private uint bits[3])
+{
+    esc_coarse(r, t, corner, bits);
+    return bits[0] | bits[1] << r->level | bits[2] << (2 * r->level);
+}
+
+/* A table's point code (lattice point (i, j) of the coarse triangle as i * ESC_STRIP_POINT_BASE
+ * + j) as the patch's vertex number. */
+inline uint esc_table_vertex(__private const esc_patch *g, __private const int2 corner[3], int code)
+{
+    return esc_index(g, esc_lattice(corner, g->r.n, (int2)(code / ESC_STRIP_POINT_BASE, code % ESC_STRIP_POINT_BASE)));
+}
+
 /* Stage 3's counts from the masks alone (esc.py counts): each coarse triangle's row of the
  * generated table (its triangles and strip indices as esc_coarse_triangle walks them; checked
  * exhaustively against the walk, tests/test_esc_counts.py), less, for a side on a collapsed edge,
@@ -504,8 +519,7 @@ inline int esc_table_counts(int4 f, int collapsed, __private uint *triangles, __
     for (int t = 0; t < 18; ++t) {
         int2 corner[3];
         uint bits[3];
-        esc_coarse(&r, t, corner, bits);
-        uint row = bits[0] | bits[1] << level | bits[2] << (2 * level);
+        uint row = esc_table_row(&r, t, corner, bits);
         *triangles += tris[row];
         *strip_indices += strips[row];
         for (int side = 0; collapsed && side < 2; ++side) {
@@ -528,19 +542,16 @@ inline uint esc_table_triangles(int4 f, int collapsed, __global uint *out, uint 
         return 0;
     esc_patch g;
     esc_setup(f, collapsed, &g);
-    int level = g.r.level, n = g.r.n;
     uint count = 0;
     for (int t = 0; t < 18; ++t) {
         int2 corner[3];
         uint bits[3];
-        esc_coarse(&g.r, t, corner, bits);
-        int row = ESC_TABLE_START[level] + (int)(bits[0] | bits[1] << level | bits[2] << (2 * level));
+        int row = ESC_TABLE_START[g.r.level] + (int)esc_table_row(&g.r, t, corner, bits);
         __constant const uchar *points = ESC_TABLE_TRIANGLE_POINTS + ESC_TABLE_TRIANGLE_FIRST[row];
         for (int k = 0, end = 3 * ESC_TABLE_TRIANGLES[row]; k < end; k += 3) {
             uint index[3];
             for (int c = 0; c < 3; ++c)
-                index[c] = esc_index(&g, esc_lattice(corner, n, (int2)(points[k + c] / ESC_STRIP_POINT_BASE,
-                                                                          points[k + c] % ESC_STRIP_POINT_BASE)));
+                index[c] = esc_table_vertex(&g, corner, points[k + c]);
             if (index[0] != index[1] && index[1] != index[2] && index[0] != index[2])
                 put_triangle(out, &count, base, index[0], index[1], index[2]);
         }
@@ -577,19 +588,16 @@ inline uint esc_table_strips(int4 f, int collapsed, __global uint *out, uint bas
         return 0;
     esc_patch g;
     esc_setup(f, collapsed, &g);
-    int level = g.r.level, n = g.r.n;
     uint at = 0;
     for (int t = 0; t < 18; ++t) {
         int2 corner[3];
         uint bits[3];
-        esc_coarse(&g.r, t, corner, bits);
-        int row = ESC_TABLE_START[level] + (int)(bits[0] | bits[1] << level | bits[2] << (2 * level));
+        int row = ESC_TABLE_START[g.r.level] + (int)esc_table_row(&g.r, t, corner, bits);
         __constant const uchar *points = ESC_TABLE_STRIP_POINTS + ESC_TABLE_STRIP_FIRST[row];
         int count = ESC_TABLE_STRIP_INDICES[row];
         for (int k = 0; out && k < count; ++k) {
             int code = points[k];
-            out[at + k] = code == ESC_STRIP_TABLE_RESTART ? STRIP_RESTART
-                : base + esc_index(&g, esc_lattice(corner, n, (int2)(code / ESC_STRIP_POINT_BASE, code % ESC_STRIP_POINT_BASE)));
+            out[at + k] = code == ESC_STRIP_TABLE_RESTART ? STRIP_RESTART : base + esc_table_vertex(&g, corner, code);
         }
         at += count;
     }
