@@ -195,7 +195,7 @@ def overlapped(session, cameras, rounds: int = 3) -> dict:
     (wall clock / frames, the last frame waited for)."""
     intervals = {True: [], False: []}
     means = {True: [], False: []}
-    device = []
+    device, not_fit = [], 0  # not_fit: frames launched on too small buffers (Session: run again or stale)
     clock = time.perf_counter
     for _ in range(rounds):
         for wait in (True, False):
@@ -209,11 +209,12 @@ def overlapped(session, cameras, rounds: int = 3) -> dict:
             kept[-1].finish()
             means[wait].append((clock() - started) / len(cameras))
             device += [device_ms(frame) for frame in kept]  # (their stages are done: in-order queue)
+            not_fit += sum(frame.stats.get("output_fit") is False for frame in kept)
     return {"looped_wall_ms": statistics.median(intervals[True]) * 1e3,
             "overlapped_wall_ms": statistics.median(intervals[False]) * 1e3,
             "looped_mean_ms": statistics.median(means[True]) * 1e3,
             "overlapped_mean_ms": statistics.median(means[False]) * 1e3,
-            "overlapped_device_ms": statistics.median(device)}
+            "overlapped_device_ms": statistics.median(device), "frames_not_fit": not_fit}
 
 
 def host_parts(session, cameras, rounds: int = 3) -> dict:
@@ -222,13 +223,16 @@ def host_parts(session, cameras, rounds: int = 3) -> dict:
     alone where the tree does), stages 1-3 enqueued, the wait for their totals, stages 4-5
     enqueued, the wait for them and the result, and the read-back to host arrays (and its
     wait).  The waits are timed by wrapping ``pyopencl.wait_for_events``, through which every
-    tree waits, so that the script gives the same split for a tree before this one."""
+    tree waits, so that the script gives the same split for a tree before this one.  A tree
+    whose Session frames launch stages 4-5 before reading the totals (``plan_on(defer_totals=
+    True)``) is timed that way: its totals are waited for within "stages 4-5 wait + result"."""
     tessellator, clock = session.tessellator, time.perf_counter_ns
     parts = {name: [] for name in ("request", "compose", "stages 1-3 (host)", "totals wait", "stages 4-5 (host)",
                                    "stages 4-5 wait + result", "of which wait", "fetch (host arrays)",
                                    "of which read-back wait", "host, total", "wall, total")}
     key = session.request.sharp_edges
     waits, wait_for_events = [], cl.wait_for_events
+    deferred = {"defer_totals": True} if "defer_totals" in inspect.signature(tessellator.plan_on).parameters else {}
 
     def timed_wait(events):
         started = clock()
@@ -246,15 +250,17 @@ def host_parts(session, cameras, rounds: int = 3) -> dict:
                 if getattr(session, "_composed", None) is None:  # (a tree before the skip: every frame)
                     tessellator.compose(session.scene, request)
                 t2 = clock()
-                plan = tessellator.plan_on(session._scene_data[key], request, None, session._scratch[key])
+                plan = tessellator.plan_on(session._scene_data[key], request, None, session._scratch[key], **deferred)
                 t3 = clock()
+                totals = sum(waits)
                 pending = tessellator.emit_async(plan, 0, plan.num_patches, out=session.output)
                 t4 = clock()
                 frame = pending.result(on_device=True)
                 t5 = clock()
+                stages45 = sum(waits) - totals
                 frame.fetch()
                 t6 = clock()
-                totals, stages45, read_back = (waits + [0, 0, 0])[:3]
+                read_back = sum(waits) - totals - stages45
                 for name, value in (("request", t1 - t0), ("compose", t2 - t1),
                                     ("stages 1-3 (host)", t3 - t2 - totals), ("totals wait", totals),
                                     ("stages 4-5 (host)", t4 - t3), ("stages 4-5 wait + result", t5 - t4),
@@ -310,6 +316,8 @@ def frame_report(record: dict) -> list[str]:
                      f"{f.get('overlapped_wall_ms', math.nan):.3f} | "
                      f"{f.get('overlapped_wall_ms', math.nan) / f.get('overlapped_device_ms', 1.0):.2f}x | "
                      f"{f['setup_s']:.1f} |")
+    not_fit = sum(f.get("frames_not_fit", 0) for f in record["frame_loop"])
+    lines += ["", f"Overlapped frames launched on buffers too small for them (run again, or stale): {not_fit}."]
     names = list(record["frame_loop"][0]["parts"]) if record["frame_loop"] else []
     lines += ["", "A frame's host time by step (µs, median; Session.tessellate's steps one by one, then fetch):", "",
               "| step | " + " | ".join(f["scene"] for f in record["frame_loop"]) + " |",

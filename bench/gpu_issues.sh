@@ -41,7 +41,7 @@ case $which in
   frame15)  # issue 15, a frame's host cost (branch frame15): the paper's scenes, then the tree before if given
     scenes="tea_table double_torus killeroo herd spheres star_field model_zoo"
     run frame_loop_frames 200 python3 bench/frame_loop.py --device nvidia --frames-only --scenes $scenes --grid-copies 1 10 --json "$out/frame_loop_frames.json"
-    run frame15_tests 150 env CLTESS_DEVICE=nvidia python3 -m pytest -q -p no:cacheprovider tests/test_frame_host.py tests/test_session.py tests/test_fused_offsets.py
+    run frame15_tests 200 env CLTESS_DEVICE=nvidia python3 -m pytest -q -p no:cacheprovider tests/test_frame_host.py tests/test_session.py tests/test_fused_offsets.py tests/test_frame_capacity.py tests/test_work_points.py
     if [ -n "${3:-}" ]; then
       run frame_loop_frames_base 200 env PYTHONPATH="$3:$PYTHONPATH" python3 bench/frame_loop.py --device nvidia --frames-only --scenes $scenes --grid-copies 1 10 --json "$out/frame_loop_frames_base.json"
       run frame_host 240 python3 bench/frame_host.py --device nvidia --frames 20 --repeat 2 --scenes $scenes --baseline "$3" --json "$out/frame_host.json"

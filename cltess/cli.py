@@ -46,7 +46,7 @@ EXIT_OK, EXIT_DEVICE, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 #: The stats printed on their own summary lines; any other int stat is listed after them.
 _MAIN_STATS = ("patches", "culled", "saturated", "vertices", "triangles")
 #: Bookkeeping of a batch, not of the result.
-_HIDDEN_STATS = ("first_patch", "last_patch")
+_HIDDEN_STATS = ("first_patch", "last_patch", "output_fit")
 
 
 class UsageError(Exception):

@@ -13,6 +13,13 @@ What a ``Session`` keeps between calls, so that a frame costs only the five stag
 * the output buffers (``OutputBuffers``), grown only when a frame needs more, and on a GPU the
   page-locked host buffers its read-back goes through.
 
+A frame does not wait for stage 3's totals before it enqueues stages 4-5: they run on the
+buffers' capacity, and write nothing if the frame's output does not fit (``batch_fits`` in
+kernels/common.h).  The host reads the totals when the frame's sizes, arrays or times are
+first asked for (or ``finish()``); an output that did not fit then runs stages 4-5 again on
+grown buffers.  So with ``wait=False`` the host's next frame is enqueued while the device still
+works on this one, with no round trip between (docs/design.md section 11).
+
 A frame's output stays on the device (``Tessellation.device``); its host arrays are read back
 when first asked for (``frame.positions``, ``frame.fetch()``): on a CPU device by mapping the
 buffers (no copy), on a GPU by a copy into the pinned buffers.  Either way they are *views of
@@ -50,6 +57,7 @@ class Session:
         self._scene_data: dict = {}  # sharp_edges -> SceneData
         self._scratch: dict = {}  # sharp_edges -> the per-patch arrays of stages 1-3
         self.frames = 0
+        self._plans: list = []  # the last two frames' plans: their totals grow the buffers for the next
         self._composed = None  # the (work, fused_offsets) of the last frame composed for the session's request
 
     @property
@@ -88,12 +96,13 @@ class Session:
         these changes to the session's request (``request_for``).  The output stays on the
         device (``.device``); host arrays on first use, valid until the next call.
 
-        wait=False: return once stages 4-5 are enqueued, without waiting for them, so that the
-        host's work until the next frame (drawing, the next camera, the next frame's stages 1-3)
-        overlaps them on the device.  Commands on the session's queue (``device.queue``,
-        in order) see the finished output; anything else waits with ``frame.finish()`` (also
-        the first look at ``frame.stage_ms``, ``frame.wall_ms`` or a host array waits).  The
-        next frame waits for this one's stages anyway (its stages 1-3 read back two totals)."""
+        wait=False: return once stages 1-5 are enqueued, without waiting for any of them, so that
+        the host's work until the next frame (drawing, the next camera, the next frame's
+        enqueueing) overlaps them on the device.  ``frame.finish()`` waits for them (as does the
+        first look at ``frame.stage_ms``, ``wall_ms``, ``stats``, its sizes or its arrays), and
+        is needed before commands on the session's queue use ``frame.device``: until the host
+        has read the frame's totals, an output larger than the buffers is not written (see
+        the module's notes)."""
         started = time.perf_counter()
         request = self.request_for(camera, **request_overrides)
         if request.bound != "hull":  # its loop re-plans and emits on the host (Tessellator.plan)
@@ -110,7 +119,16 @@ class Session:
         if key not in self._scene_data:
             self._scene_data[key] = tessellator.scene_data(self.scene, key)
             self._scratch[key] = {}
-        plan = tessellator.plan_on(self._scene_data[key], request, started, self._scratch[key])
+        # The frame before last is settled (its totals are read: a wait only if the device is two
+        # frames behind, so no more than two frames are ever in flight), the last one if its
+        # totals are there; the buffers then hold at least what those needed.
+        for age, plan in enumerate(reversed(self._plans)):
+            if age == 1 or plan.totals_ready():
+                plan.settle()
+            if plan.settled:
+                self.output.reserve(plan.num_vertices, plan.num_indices // 3)
+        plan = tessellator.plan_on(self._scene_data[key], request, started, self._scratch[key], defer_totals=True)
+        self._plans = [*self._plans[-1:], plan]
         self.frames += 1
         return tessellator.emit_async(plan, 0, plan.num_patches, out=self.output).result(on_device=True, wait=wait)
 

@@ -46,7 +46,9 @@ class DeviceOutput:
     larger reused buffer).  Triangle indices are global: vertex i of this batch is number
     ``vertex_base + i`` (0 for a whole scene).
     read_back: returns the host arrays (a dict with the same keys); valid: whether the buffers
-    still hold this output (False once a session's next frame reused them).
+    still hold this output (False once a session's next frame reused them); settle: called
+    before the arrays or sizes are first given, for an output whose size the host learns late
+    (a Session frame, launched before stage 3's totals were read back).
     """
 
     arrays: dict
@@ -54,12 +56,14 @@ class DeviceOutput:
     vertex_base: int = 0
     read_back: Callable[[], dict] | None = None
     valid: Callable[[], bool] = lambda: True
+    settle: Callable[[], None] = lambda: None
 
     def __getattr__(self, name):
         arrays = self.__dict__.get("arrays", {})
         if name in arrays:
             self.check()
-            return arrays[name]
+            self.settle()
+            return self.arrays[name]
         raise AttributeError(name)
 
     def check(self) -> None:
@@ -69,14 +73,17 @@ class DeviceOutput:
 
     @property
     def num_vertices(self) -> int:
+        self.settle()
         return int(getattr(self.arrays, "num_vertices", None) or self.arrays["positions"].shape[0])
 
     @property
     def num_triangles(self) -> int:
+        self.settle()
         return int(getattr(self.arrays, "num_triangles", None) or self.arrays["triangles"].shape[0])
 
     @property
     def nbytes(self) -> int:
+        self.settle()
         return sum(int(a.nbytes) for a in self.arrays.values())
 
 
@@ -142,15 +149,17 @@ class Tessellation(IndexedMesh):
     real_factors: np.ndarray | None = None
 
     @classmethod
-    def on_device(cls, device: DeviceOutput, stage_ms: dict | None, stats: dict, wall_ms: dict | None,
+    def on_device(cls, device: DeviceOutput, stage_ms: dict | None, stats: dict | None, wall_ms: dict | None,
                   strips: np.ndarray | None = None, finish=None) -> "Tessellation":
         """A result whose host arrays (and factors) are read back from ``device`` when first
         asked for (strips, when a pattern makes them, are host arrays already).  finish: for a
         result whose stages may still run (``Session.tessellate(wait=False)``), a function that
-        waits for them and sets ``stage_ms`` and ``wall_ms`` (given as None); called by
-        ``finish()`` or the first look at either."""
+        waits for them and sets ``stage_ms``, ``wall_ms`` and ``stats`` (given as None); called
+        by ``finish()`` or the first look at one of them."""
         tess = object.__new__(cls)
-        tess.stats, tess.device, tess.strips = stats, device, strips
+        tess.device, tess.strips = device, strips
+        if stats is not None:  # else finish sets it
+            tess.stats = stats
         if stage_ms is not None:
             tess.stage_ms, tess.wall_ms = stage_ms, wall_ms
         if finish is not None:
@@ -168,7 +177,7 @@ class Tessellation(IndexedMesh):
     def __getattr__(self, name):
         # Called only for attributes not set: the host arrays of a device-resident result, and
         # the times of one whose stages were not waited for.
-        if name in ("stage_ms", "wall_ms") and "_finish" in self.__dict__:
+        if name in ("stage_ms", "wall_ms", "stats") and "_finish" in self.__dict__:
             self.finish()
             return self.__dict__[name]
         if name in HOST_FIELDS and self.__dict__.get("device") is not None:

@@ -259,6 +259,16 @@ inline int batch_patch(uint first_patch, uint num_patches, __global const int4 *
     return f->s0 > 0;
 }
 
+/* Whether the batch's output fits its buffer: its records (vertices or indices) run from
+ * offsets[first_patch] - base to offsets[last] - base, and the buffer holds `capacity` of them.
+ * A Session frame launches stages 4-5 before the host has read stage 3's totals (on the
+ * buffers' capacity: docs/design.md section 11); a batch that does not fit writes nothing,
+ * and the host, reading the totals later, grows the buffers and runs stages 4-5 again. */
+inline int batch_fits(__global const ulong *offsets, uint last, ulong base, ulong capacity)
+{
+    return offsets[last] - base <= capacity;
+}
+
 /* The patch owning output slot `at` (a vertex, or an index; global numbering) among patches
  * lo .. hi - 1 whose slots start at offsets[p] (stage 3's scan): the last p with offsets[p] <= at
  * (binary search; a culled patch owns no slot, so the one found is never culled).  Needs

@@ -433,6 +433,10 @@ PREPARED_POINTS = {"uniform_by_prepared_points": "uniform", "pn_icosphere_by_pre
                    "mixed_culled_by_prepared_points": "mixed_culled",
                    "many_patches_batched_by_prepared_points": ("many_patches", 4096)}
 POINTS.update(PREPARED_POINTS)
+#: Session frames (cltess.Session) whose second frame does not fit the first one's buffers:
+#: stages 4-5 launched on the buffers' capacity write nothing (batch_fits, kernels/common.h),
+#: then run again on grown buffers (issue 15, docs/design.md section 11); per patch and per point.
+FRAMES = {"many_patches_frames": ("many_patches", "patch"), "many_patches_frames_by_points": ("many_patches", "point")}
 #: Scenarios whose stage 3 is one launch per range (Tessellator.fused_offsets: stages/offsets.cl),
 #: with work-groups of FUSED_OFFSETS_GROUP_HERE patches so that a range takes several tiles: two
 #: kinds (two ranges, the second from the first's total), culled patches, more patches than a tile.
@@ -558,6 +562,19 @@ def run_scenario(name: str, tessellator, out_dir: Path) -> dict:
             tess = tessellator.emit(plan, 0, plan.num_patches)
         finally:
             tessellator.fused_offsets, opencl.FUSED_OFFSETS_GROUP = saved
+    elif name in FRAMES:
+        from cltess.session import Session
+
+        base, work = FRAMES[name]
+        scene, options = SCENARIOS[base]()
+        saved = tessellator.work
+        tessellator.work = work
+        try:
+            session = Session(scene, tessellator=tessellator, **{**options, "max_factor": 1})  # a small first frame
+            session.tessellate()
+            tess = session.tessellate(max_factor=options.get("max_factor", 64)).fetch()
+        finally:
+            tessellator.work = saved
     elif name in POINTS:
         base, cap = POINTS[name] if isinstance(POINTS[name], tuple) else (POINTS[name], None)
         scene, options = SCENARIOS[base]()

@@ -46,11 +46,11 @@ __kernel void prepare_patches(__global const float4 *controls, __global const ul
 __kernel void prepared_points(__global const kind_patch *restrict prepared, __global const int4 *factors,
                               __global const ulong *vertex_offsets, __global const int *patch_objects,
                               uint first_patch, uint num_patches, ulong vertex_base,
-                              int forward_differencing, uint per_item,
+                              int forward_differencing, ulong capacity, uint per_item,
                               __global float *positions, __global float *normals, __global float *uv,
                               __global int *patch_ids, __global int *object_ids)
 {
     vertex_out out = {positions, normals, uv, patch_ids, object_ids};
     put_points(0, 0, 1, prepared, factors, vertex_offsets, patch_objects, first_patch, num_patches, vertex_base,
-               forward_differencing, per_item, out);
+               forward_differencing, capacity, per_item, out);
 }

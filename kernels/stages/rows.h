@@ -119,14 +119,16 @@ ALWAYS_INLINE void put_point(__private const kind_patch *patch, int4 f, int coll
  * stores are side by side.  A work-item finds (patch_of) and loads a patch only when its next
  * vertex is in another one: from prepared[p - first_patch] when from_prepared (a literal, so each kernel
  * keeps one of the two; no arithmetic), else by kind_load from controls.  Work-items past the
- * batch's last vertex stop. */
+ * batch's last vertex stop; a batch of more than `capacity` vertices writes none (batch_fits). */
 ALWAYS_INLINE void put_points(__global const float4 *controls, uint patch_base, const int from_prepared,
                               __global const kind_patch *prepared, __global const int4 *factors,
                               __global const ulong *vertex_offsets, __global const int *patch_objects,
                               uint first_patch, uint num_patches, ulong vertex_base,
-                              int forward_differencing, uint per_item, vertex_out out)
+                              int forward_differencing, ulong capacity, uint per_item, vertex_out out)
 {
     uint last = first_patch + num_patches;
+    if (!batch_fits(vertex_offsets, last, vertex_base, capacity))
+        return;
     ulong end = vertex_offsets[last], group = get_local_size(0);
     ulong at = vertex_offsets[first_patch] + get_group_id(0) * group * per_item + get_local_id(0);
     uint p = first_patch;

@@ -14,9 +14,11 @@
  * triangle stop. */
 __kernel void triangles(__global const int4 *factors, __global const ulong *vertex_offsets,
                         __global const ulong *index_offsets, uint first_patch, uint num_patches,
-                        ulong index_base, uint per_item, __global uint *indices)
+                        ulong index_base, ulong capacity, uint per_item, __global uint *indices)
 {
     uint last = first_patch + num_patches;
+    if (!batch_fits(index_offsets, last, index_base, capacity))
+        return;
     ulong end = index_offsets[last] / 3, group = get_local_size(0), first_triangle = index_base / 3;
     ulong at = index_offsets[first_patch] / 3 + get_group_id(0) * group * per_item + get_local_id(0);  /* a triangle */
     uint p = first_patch, base = 0;

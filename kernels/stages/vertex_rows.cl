@@ -11,14 +11,14 @@
 __kernel void vertex_rows(__global const float4 *controls, __global const int4 *factors,
                           __global const ulong *vertex_offsets, __global const int *patch_objects,
                           uint first_patch, uint num_patches, uint patch_base, ulong vertex_base,
-                          int forward_differencing, uint rows_per_patch,
+                          int forward_differencing, ulong capacity, uint rows_per_patch,
                           __global float *positions, __global float *normals, __global float *uv,
                           __global int *patch_ids, __global int *object_ids)
 {
     size_t item = get_global_id(0);
     uint q = (uint)(item / rows_per_patch);
     int first_row = (int)(item % rows_per_patch);
-    if (q >= num_patches)
+    if (q >= num_patches || !batch_fits(vertex_offsets, first_patch + num_patches, vertex_base, capacity))
         return;
     uint p = first_patch + q;
     int collapsed;

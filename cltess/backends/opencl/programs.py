@@ -9,6 +9,8 @@ headers fulfil is in docs/extending.md.
 """
 from __future__ import annotations
 
+import os
+import shlex
 from importlib import resources
 from pathlib import Path
 
@@ -128,6 +130,13 @@ def correctly_rounded_division(device: cl.Device) -> list[str]:
     return ["-cl-fp32-correctly-rounded-divide-sqrt"] if config & cl.device_fp_config.CORRECTLY_ROUNDED_DIVIDE_SQRT else []
 
 
+def extra_build_options() -> list[str]:
+    """Compiler options added to every stage program from ``CLTESS_BUILD_OPTIONS`` (shell
+    words), for tuning a device's compiler, e.g. ``-cl-nv-maxrregcount=128`` on NVIDIA.  They
+    are part of pyopencl's cache key, so a change rebuilds."""
+    return shlex.split(os.environ.get("CLTESS_BUILD_OPTIONS", ""))
+
+
 class Programs:
     """The built programs of one context, each built once per composition (pyopencl also
     caches the binaries on disk)."""
@@ -187,7 +196,7 @@ class Programs:
 
     def build(self, stage: str, headers: tuple, defines: dict) -> cl.Program:
         source, options = program_text(stage, headers, defines)
-        options += correctly_rounded_division(self.context.devices[0])
+        options += correctly_rounded_division(self.context.devices[0]) + extra_build_options()
         try:
             return cl.Program(self.context, source).build(options=options)
         except cl.RuntimeError as error:  # the build log is in the message

@@ -298,12 +298,15 @@ class Tessellator:
         return SceneData(scene, sharp_edges, base, parts, objects, self.upload_groups(groups, base), stats)
 
     def plan_on(self, data: "SceneData", request: Request, started: float | None = None,
-                scratch: dict | None = None, stage1_hook=None) -> "Plan":
+                scratch: dict | None = None, stage1_hook=None, defer_totals: bool = False) -> "Plan":
         """Stages 1-3 on a scene's device data (``scene_data``) for a request (its programs
         built: ``compose``).  scratch: a dict in which the per-patch arrays (factors, flags,
         counts, offsets) are kept and reused from call to call (a ``Session``'s), so that a
         new plan overwrites the last one's; else fresh arrays.  stage1_hook(factors, flags):
-        called after stage 1, before stage 2, may rewrite the factors (integral.py's trials)."""
+        called after stage 1, before stage 2, may rewrite the factors (integral.py's trials).
+        defer_totals: return without waiting for the totals' read-back (``Plan.settle`` waits;
+        a Session frame's stages 4-5 are enqueued meanwhile, docs/design.md section 11), where
+        nothing else of the plan is read back (no strips, no semi-uniform levels)."""
         started = time.perf_counter() if started is None else started
         scene, count = data.scene, data.num_patches
         tolerance = request.tolerance_for(scene)
@@ -333,30 +336,25 @@ class Tessellator:
         events["counts"] += strips[1]
         totals = np.zeros(2, np.uint64)  # the two read-backs, and the flags, waited for at once
         flag_values = np.empty(count, np.int32)
-        waited = wait_ms([
+        copies = [
             cl.enqueue_copy(self.queue, totals[:1], vertex_offsets.data, src_offset=8 * count, is_blocking=False),
             cl.enqueue_copy(self.queue, totals[1:], index_offsets.data, src_offset=8 * count, is_blocking=False),
-            cl.enqueue_copy(self.queue, flag_values, flags.data, is_blocking=False)])
-        num_vertices, num_indices = int(totals[0]), int(totals[1])
-        num_strip_indices = int(strips[0][count].get()) if strips[0] is not None else 0  # a third read-back
-        check_totals(scene.name, num_vertices)
-        stats = {
-            "patches": count,
-            "culled": int(np.count_nonzero(flag_values & FLAG_CULLED)),
-            "saturated": int(np.count_nonzero(flag_values & FLAG_SATURATED)),
-            "vertices": num_vertices,
-            "triangles": num_indices // 3,
-            **data.stats,
-            **level_stats,
-        }
-        read_back = {}
+            cl.enqueue_copy(self.queue, flag_values, flags.data, is_blocking=False)]
+        stats = {"patches": count, "culled": None, "saturated": None, "vertices": None, "triangles": None,
+                 **data.stats, **level_stats}  # the counts: Plan.settle
+        plan = Plan(scene.name, count, parts, data.objects, final, vertex_offsets, index_offsets, None, None,
+                    stats, events, started, request, strip_offsets=strips[0],
+                    _pending=(totals, flag_values, copies))
+        if defer_totals and strips[0] is None and not any(part.pattern.dyadic for part in parts):
+            return plan
+        plan.settle()
+        if strips[0] is not None:
+            plan.num_strip_indices = int(strips[0][count].get())  # a third read-back
         if any(part.pattern.dyadic for part in parts):  # the semi-uniform patches' levels
-            read_back["factors"] = final.get()
+            plan._host["factors"] = final.get()
             stats["patch_levels"] = level_histogram(np.concatenate(
-                [read_back["factors"][p.base:p.base + p.count] for p in parts if p.pattern.dyadic]))
-        return Plan(scene.name, count, parts, data.objects, final, vertex_offsets, index_offsets,
-                    num_vertices, num_indices, stats, events, started, request, _host=read_back,
-                    strip_offsets=strips[0], num_strip_indices=num_strip_indices, wait_ms=waited)
+                [plan._host["factors"][p.base:p.base + p.count] for p in parts if p.pattern.dyadic]))
+        return plan
 
     def upload_groups(self, groups, num_patches: int) -> dict:
         """Stage 2's edge groups (cltess.crack.adjacency.EdgeGroups over the P * 4 edge slots)
@@ -415,10 +413,16 @@ class Tessellator:
             return _Ready(emit_by_level(self, plan, first, last))
         if forward_differencing is None:
             forward_differencing = plan.request.forward_differencing
-        vertex_range = plan.vertex_range(first, last)
-        index_range = plan.index_range(first, last)
-        events = dict(plan.events) if first == 0 else {}
         buffers = out if out is not None else OutputBuffers(self)
+        capacity = buffers.capacity
+        if not plan.settled and ((first, last) != (0, plan.num_patches) or not min(capacity)):
+            plan.settle()  # a part of the plan, or no buffers yet: their sizes from the totals
+        if plan.settled:
+            vertex_range = plan.vertex_range(first, last)
+            index_range = plan.index_range(first, last)
+        else:  # on the buffers' capacity; PendingEmit.result runs them again if it was too small
+            vertex_range, index_range = (0, capacity[0]), (0, 3 * capacity[1])
+        events = dict(plan.events) if first == 0 else {}
         arrays = buffers.take(vertex_range[1] - vertex_range[0], (index_range[1] - index_range[0]) // 3)
         vertices = {name: arrays.raw(name) for name, _, _ in VERTEX_RECORD}
         events["vertices"], events["indices"] = [], []
@@ -437,7 +441,8 @@ class Tessellator:
         if plan.strip_offsets is not None:
             strips, events["strips"] = emit_strips(self, plan, first, last)
         self.queue.flush()
-        return PendingEmit(self, plan, first, last, vertex_range[0], arrays, events, buffers, strips)
+        return PendingEmit(self, plan, first, last, vertex_range[0], arrays, events, buffers, strips,
+                           forward_differencing)
 
     # --- stage 6 on request: the error, measured (issue 9 item 9) ---------------------------------
 
@@ -629,7 +634,10 @@ class Tessellator:
         first patch is patch_base; controls: that kind's stage-4 input, Bézier patches or PN
         control points), whose vertices are vertex_range = (start, stop) -> dict of positions
         (V, 3), normals (V, 3), uv (V, 2), patch_ids (V,), object_ids (V,) device arrays,
-        V = stop - start (written into ``out`` when given), and the events.  rows_per_patch:
+        V = stop - start (written into ``out`` when given), and the events.  The patches'
+        vertices may be fewer than V (a Session frame launched on the buffers' capacity before
+        stage 3's totals were read); if they are more, the kernels write none (batch_fits in
+        kernels/common.h).  rows_per_patch:
         work-items per patch of stages/vertex_rows.cl (0: one per patch, stages/vertices.cl;
         None: as ``work``).  work: "patch", "rows" (with ``MAX_ROWS_PER_PATCH``), "vertex" or
         "point" (stages/vertex_points.cl, a work-item per vertex), "vertex-prep" or "point-prep"
@@ -642,7 +650,7 @@ class Tessellator:
         pattern = pattern or kind.pattern
         arguments = (controls.data, factors.data, vertex_offsets.data, patch_objects.data, np.uint32(first),
                      np.uint32(last - first), np.uint32(patch_base), np.uint64(vertex_range[0]),
-                     np.int32(forward_differencing))
+                     np.int32(forward_differencing), np.uint64(vertex_range[1] - vertex_range[0]))
         work = work or self.work
         if rows_per_patch is None and work == "rows":
             rows_per_patch = MAX_ROWS_PER_PATCH
@@ -695,14 +703,15 @@ class Tessellator:
             self.queue, _record_groups(vertex_range[1] - vertex_range[0], self.per_item), (WORK_GROUP,),
             self._prepared, factors.data, vertex_offsets.data, patch_objects.data, np.uint32(first),
             np.uint32(last - first), np.uint64(vertex_range[0]), np.int32(forward_differencing),
-            np.uint32(self.per_item), *(a.data for a in out.values()))
+            np.uint64(vertex_range[1] - vertex_range[0]), np.uint32(self.per_item), *(a.data for a in out.values()))
         return prepare, points
 
     def stage_indices(self, factors, vertex_offsets, index_offsets, index_range, patch_range,
                       kind=BEZIER, out=None, work: str | None = None):
         """Stage 5 for patches patch_range = (first, last) (scene numbers, all of one kind or
         pattern), whose indices are index_range = (start, stop) -> triangles ((stop - start) / 3,
-        3) uint32 device array (``out`` when given), and the events.  work: "point" a work-item
+        3) uint32 device array (``out`` when given), and the events; as stage_vertices, the
+        patches' indices may be fewer, and none is written if they are more.  work: "point" a work-item
         per triangle (stages/triangles.cl), else per patch (stages/indices.cl); None: the
         Tessellator's ``work``."""
         n = index_range[1] - index_range[0]
@@ -711,7 +720,7 @@ class Tessellator:
         if not n or last <= first:
             return triangles, []
         arguments = (factors.data, vertex_offsets.data, index_offsets.data, np.uint32(first),
-                     np.uint32(last - first), np.uint64(index_range[0]))
+                     np.uint32(last - first), np.uint64(index_range[0]), np.uint64(n))
         if (work or self.work) in ("point", "point-prep"):  # work-items past the part's triangles stop
             event = self.programs.kernel("triangles", pattern=_pattern(kind))(
                 self.queue, _record_groups(n // 3, self.per_item), (WORK_GROUP,), *arguments,
@@ -804,18 +813,44 @@ class PendingEmit:
     events: dict
     buffers: "OutputBuffers"
     strips: np.ndarray | None = None  # host strips of a strip pattern (cltess.strips)
+    forward_differencing: bool | None = None  # as asked of emit_async (a run again asks the same)
 
     def result(self, on_device: bool = False, wait: bool = True) -> Tessellation:
         """The Tessellation.  wait=False (with on_device): return at once, the stages still
-        running; the first look at its ``stage_ms``, ``wall_ms`` or host arrays, or
-        ``finish()``, waits for them (commands on the same in-order queue need no wait)."""
+        running; the first look at its ``stage_ms``, ``wall_ms``, ``stats``, sizes or arrays,
+        or ``finish()``, waits for them (commands on the same in-order queue need no wait).
+
+        A plan not yet settled (a Session frame: stages 4-5 launched on the buffers' capacity)
+        settles first: if its output did not fit, the kernels wrote nothing, and stages 4-5 run
+        again on buffers grown to its totals, unless a later frame has taken the buffers (this
+        output is stale then, and its plan's arrays are that frame's)."""
         if not wait and not on_device:
             raise ValueError("wait=False leaves the output on the device: give on_device=True too")
-        plan, first, last, buffers, arrays = self.plan, self.first, self.last, self.buffers, self.arrays
-        stats = dict(plan.stats, first_patch=first, last_patch=last)
-        generation, events, times = buffers.generation, self.events, {}
+        plan, first, last, buffers = self.plan, self.first, self.last, self.buffers
+        events, times = self.events, {}
+        current = {"arrays": self.arrays, "generation": buffers.generation}
+        launched_on_capacity = not plan.settled
+
+        def settle() -> None:  # the totals known; stages 4-5 again where the output did not fit
+            if plan.settled and "stats" in times:
+                return
+            plan.settle()
+            arrays = current["arrays"]
+            fits = plan.num_vertices <= arrays.num_vertices and plan.num_indices // 3 <= arrays.num_triangles
+            times["stats"] = dict(plan.stats, first_patch=first, last_patch=last)
+            if launched_on_capacity:  # False: the first launch of stages 4-5 wrote nothing (too small)
+                times["stats"]["output_fit"] = fits
+            if fits:
+                arrays.num_vertices, arrays.num_triangles = plan.num_vertices, plan.num_indices // 3
+            elif buffers.generation == current["generation"]:  # (stale otherwise: left as it is)
+                again = self.tessellator.emit_async(plan, first, last, self.forward_differencing, out=buffers)
+                events.update(vertices=again.events["vertices"], indices=again.events["indices"])
+                current.update(arrays=again.arrays, generation=buffers.generation)
+                device.arrays = again.arrays
 
         def finish(tess: Tessellation) -> None:  # wait for the stages; their times
+            settle()
+            tess.stats = times["stats"]
             all_events = [event for evs in events.values() for event in evs]
             waited = wait_ms(all_events) if all_events else 0.0
             tess.stage_ms = {stage: _span_ms(evs) for stage, evs in events.items() if evs}
@@ -825,15 +860,15 @@ class PendingEmit:
 
         def read_back() -> dict:  # (Tessellation.fetch has waited for the stages: finish)
             plan.enqueue_host_factors()  # with the output's copies or maps: one wait for all
-            host = buffers.read_back(arrays.num_vertices, arrays.num_triangles)
+            host = buffers.read_back(current["arrays"].num_vertices, current["arrays"].num_triangles)
             if "wall_ms" in times:
                 times["wall_ms"]["waits"] += buffers.read_back_wait_ms
             host["factors"], host["real_factors"] = plan.output_factors(first, last)
             return host
 
-        device = DeviceOutput(arrays, self.tessellator.queue, self.vertex_base, read_back,
-                              valid=lambda: buffers.generation == generation)
-        tess = Tessellation.on_device(device, None, stats, None, self.strips, finish=finish)
+        device = DeviceOutput(self.arrays, self.tessellator.queue, self.vertex_base, read_back,
+                              valid=lambda: buffers.generation == current["generation"], settle=settle)
+        tess = Tessellation.on_device(device, None, None, None, self.strips, finish=finish)
         if wait:
             tess.finish()
         if not on_device:
@@ -984,6 +1019,20 @@ class OutputBuffers:
         return self._staging[name][1]
 
     @property
+    def capacity(self) -> tuple[int, int]:
+        """(vertices, triangles) the buffers hold now; (0, 0) before the first ``take``."""
+        if not self._buffers:
+            return 0, 0
+        return (min(capacity for name, (_, capacity) in self._buffers.items() if name != "triangles"),
+                self._buffers["triangles"][1])
+
+    def reserve(self, num_vertices: int, num_triangles: int) -> None:
+        """Grow the buffers now (as ``take`` would) if they hold fewer than this."""
+        vertices, triangles = self.capacity
+        if (vertices, triangles) != (0, 0) and (num_vertices > vertices or num_triangles > triangles):
+            self.take(max(num_vertices, vertices), max(num_triangles, triangles))  # (a new generation)
+
+    @property
     def nbytes(self) -> int:
         if self._parent is not None:
             return self._parent.size
@@ -1024,8 +1073,8 @@ class Plan:
     factors: cl_array.Array
     vertex_offsets: cl_array.Array
     index_offsets: cl_array.Array
-    num_vertices: int
-    num_indices: int
+    num_vertices: int | None  # None until settle (plan_on(defer_totals=True))
+    num_indices: int | None
     stats: dict
     events: dict
     started: float
@@ -1034,6 +1083,32 @@ class Plan:
     strip_offsets: cl_array.Array | None = None  # strip patterns' (P+1,) strip index offsets
     num_strip_indices: int = 0
     wait_ms: float = 0.0  # host ms blocked waiting for stages 1-3's totals (wall_ms["waits"])
+    _pending: tuple | None = None  # (totals, flags, their copies' events) until settle
+
+    @property
+    def settled(self) -> bool:
+        """Whether the totals are known (``settle`` has run)."""
+        return self._pending is None
+
+    def totals_ready(self) -> bool:
+        """Whether the totals' copies have completed (settle would not wait)."""
+        return self._pending is None or all(
+            event.command_execution_status == cl.command_execution_status.COMPLETE for event in self._pending[2])
+
+    def settle(self) -> "Plan":
+        """Wait for stage 3's totals and the flags (copied without waiting by plan_on) and
+        fill in num_vertices, num_indices and the counts of ``stats``."""
+        if self._pending is None:
+            return self
+        totals, flags, copies = self._pending
+        self.wait_ms += wait_ms(copies)
+        self._pending = None
+        self.num_vertices, self.num_indices = int(totals[0]), int(totals[1])
+        check_totals(self.name, self.num_vertices)
+        self.stats.update(culled=int(np.count_nonzero(flags & FLAG_CULLED)),
+                          saturated=int(np.count_nonzero(flags & FLAG_SATURATED)),
+                          vertices=self.num_vertices, triangles=self.num_indices // 3)
+        return self
 
     def output_factors(self, first: int, last: int) -> tuple[np.ndarray, np.ndarray | None]:
         """(factors (n, 4) int32: each edge's segments, real_factors (n, 4) float32 or None when
