@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pyopencl as cl
 import pyopencl.array as cl_array
+import pyopencl.tools as cl_tools
 
 from ...criteria.tolerance import ObjectSpace, ScreenSpace
 from ...crack.adjacency import merge_edge_groups
@@ -196,6 +197,8 @@ class Tessellator:
         self.context = shared_context(self.device)
         self.queue = cl.CommandQueue(self.context, properties=cl.command_queue_properties.PROFILING_ENABLE)
         self.programs = Programs.of(self.context)
+        # The scans' temporary arrays (two per call) from a pool, not a new buffer each frame.
+        self._scan_memory = cl_tools.MemoryPool(cl_tools.ImmediateAllocator(self.queue))
         self._prepared = None  # work="*-prep": the prepared patches' scratch buffer (_prepared_points)
         self.fused_offsets = default_fused_offsets(self.device)  # stage 3 by stages/offsets.cl
         self._cpu = pure_cpu(self.device)  # stage 3 fused up to FUSED_OFFSETS_MAX_PATCHES_CPU only
@@ -630,10 +633,10 @@ class Tessellator:
             vertex_counts.data, index_counts.data) for k, base, n in ranges if n]
         if self.one_scan:  # both offsets in one scan of (vertex, index) pairs (programs.py)
             events.append(self.programs.offsets_pair_scan(vertex_counts, index_counts, vertex_offsets,
-                                                          index_offsets))
+                                                          index_offsets, allocator=self._scan_memory))
         else:
-            events += [self.programs.offsets_scan(vertex_counts, vertex_offsets),
-                       self.programs.offsets_scan(index_counts, index_offsets)]
+            events += [self.programs.offsets_scan(vertex_counts, vertex_offsets, allocator=self._scan_memory),
+                       self.programs.offsets_scan(index_counts, index_offsets, allocator=self._scan_memory)]
         return vertex_offsets, index_offsets, events
 
     def _fused_offsets(self, pattern, factors, base, n, vertex_counts, index_counts, vertex_offsets,
