@@ -17,8 +17,8 @@ frame records
 * "(host)" after each: that wall minus the ms blocked in ``pyopencl.wait_for_events`` (patched
   in the child to time it, in both trees): the host's own work per frame;
 * "looped", "overlap" (a tree with ``Session.tessellate(wait=False)``): a loop over the cameras
-  with frames that wait and with frames that overlap, the median interval from one call's return
-  to the next (``frame_loop.overlapped``).
+  with frames that wait and with frames that overlap, the loop's wall clock over its frames
+  until the last one is finished (``frame_loop.overlapped``).
 
 Per scene the report gives, for each tree, the median over frames, then the *smallest* of the
 ``--repeat`` children's medians (the machine is shared: the least disturbed run), and the
