@@ -101,6 +101,7 @@ def test_a_stale_frame_is_not_run_again_and_the_next_one_fits(tessellator, tea_t
     assert following.stats["output_fit"] is True
     assert_same_output(following, one_shot(tessellator, tea_table, session, eps=0.002))
     assert unseen.stats["output_fit"] is False  # settled, not run again: its buffers are the next frame's
+    assert (unseen.num_vertices, unseen.num_triangles) == (following.num_vertices, following.num_triangles)
     with pytest.raises(StaleOutput):
         unseen.fetch()
 

@@ -868,9 +868,9 @@ class PendingEmit:
             times["stats"] = dict(plan.stats, first_patch=first, last_patch=last)
             if launched_on_capacity:  # False: the first launch of stages 4-5 wrote nothing (too small)
                 times["stats"]["output_fit"] = fits
-            if fits:
+            if fits or buffers.generation != current["generation"]:  # (stale: its sizes, never its arrays)
                 arrays.num_vertices, arrays.num_triangles = plan.num_vertices, plan.num_indices // 3
-            elif buffers.generation == current["generation"]:  # (stale otherwise: left as it is)
+            else:
                 again = self.tessellator.emit_async(plan, first, last, self.forward_differencing, out=buffers)
                 events.update(vertices=again.events["vertices"], indices=again.events["indices"])
                 current.update(arrays=again.arrays, generation=buffers.generation)
