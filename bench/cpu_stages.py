@@ -11,10 +11,13 @@ plan's device buffers, each kernel launched alone ``--repeat`` times:
   (565 MB): the memory-write rate;
 * **stage 4** (the engine's ``vertices``, a work-item per patch) and **stage 5** (``indices``);
 * probes of stage 4 (``bench/kernels/cpu_stage4_probe.cl``): the ring alone and the interior
-  rows alone (the engine's own ``put_ring`` / ``put_rows``), and the rows 8 at a time in float8
+  rows alone (the engine's own ``put_ring`` / ``put_rows``), the ring 8 points at a time in
+  float8 lanes (``ring_soa8``), and the rows 8 at a time in float8
   lanes (``rows_soa8``, with Intel's builtin forms, on Intel's runtime only: PoCL 3.0 crashed
-  running it), with and without its stores;
-  ring + rows and ring + rows_soa8 are hashed against the engine's stage 4 ("same bits");
+  running it), with its stores, with the same bytes stored as whole float8 vectors (not the
+  output's layout: what the stores would cost after a transpose) and without stores;
+  ring + rows, ring + rows_soa8 and ring_soa8 + rows_soa8 are hashed against the engine's stage 4
+  ("same bits");
 * with ``--baseline-kernels DIR`` (a kernels/ folder of another tree, e.g. ``git archive`` of
   main), its stage 4 and 5 built from there too, side by side.
 
@@ -134,6 +137,7 @@ def main(argv=None) -> int:
     probe_source = PROBE.read_text()
     probe = build(context, device, kernel_dir(), probe_source, "vertices", part.pattern, forms)
     sink = build(context, device, kernel_dir(), probe_source, "vertices", part.pattern, forms + ("SINK_ONLY",))
+    lanes_stored = build(context, device, kernel_dir(), probe_source, "vertices", part.pattern, forms + ("STORE_LANES",))
     octets = (16 - 1 + 7) // 8  # rows of a level-16 patch, 8 per work-item
 
     def launch_stage4(kernel):
@@ -160,6 +164,11 @@ def main(argv=None) -> int:
         measure(f"rows, 8 in float8 lanes{suffix}", lambda: probe.rows_soa8(
             queue, (-(-patches * octets // 64) * 64,), None, *common, np.uint32(octets), *buffers))
         record["digests"]["ring + rows_soa8"] = digest(out)
+        measure(f"ring, 8 points in float8 lanes{suffix}", lambda: probe.ring_soa8(
+            queue, (-(-patches * 4 * 2 // 64) * 64,), None, *common, np.uint32(2), *buffers))
+        record["digests"]["ring_soa8 + rows_soa8"] = digest(out)
+        measure(f"rows, 8 in float8 lanes, stored as float8{suffix}", lambda: lanes_stored.rows_soa8(
+            queue, (-(-patches * octets // 64) * 64,), None, *common, np.uint32(octets), *buffers))
         measure(f"rows, 8 in float8 lanes, no stores{suffix}", lambda: sink.rows_soa8(
             queue, (-(-patches * octets // 64) * 64,), None, *common, np.uint32(octets), *buffers))
     record["figures"] = rows
@@ -177,7 +186,9 @@ def main(argv=None) -> int:
     ring_vertices = patches * 64  # 4 edges of 16 points a patch
     written = {"fill": output_bytes, "stage 4 (vertices)": vertices * 40, "stage 5 (indices)": plan.num_indices * 4,
                "ring only": ring_vertices * 40, "rows only": (vertices - ring_vertices) * 40,
-               "rows, 8 in float8 lanes": (vertices - ring_vertices) * 40}
+               "rows, 8 in float8 lanes": (vertices - ring_vertices) * 40,
+               "rows, 8 in float8 lanes, stored as float8": (vertices - ring_vertices) * 40,
+               "ring, 8 points in float8 lanes": ring_vertices * 40}
     for label in kernels:
         written[f"{label}stage 4 (vertices)"] = written["stage 4 (vertices)"]
         written[f"{label}stage 5 (indices)"] = written["stage 5 (indices)"]
@@ -199,7 +210,8 @@ def main(argv=None) -> int:
     soa8 = record["digests"].get("ring + rows_soa8")
     lines.append(f"ring + rows same bits as stage 4: {'yes' if record['digests']['ring + rows'] == same else 'NO'}; "
                  f"ring + rows_soa8 (Intel's forms): "
-                 f"{'not run (Intel only)' if soa8 is None else 'yes' if soa8 == same else 'NO'}")
+                 f"{'not run (Intel only)' if soa8 is None else 'yes' if soa8 == same else 'NO'}; "
+                 f"ring_soa8 + rows_soa8: {'not run' if soa8 is None else 'yes' if record['digests']['ring_soa8 + rows_soa8'] == same else 'NO'}")
     print("\n".join(lines))
     if args.json:
         Path(args.json).write_text(json.dumps(record, indent=1, default=float) + "\n")

@@ -5,6 +5,10 @@
  *
  *   ring_only  a work-item per patch: the ring (stages/rows.h put_ring), nothing else.
  *   rows_only  a work-item per patch: the interior rows (put_rows), nothing else.
+ *   ring_soa8  a work-item per (patch, edge, octet of its ring points): 8 ring points in float8
+ *              lanes, the operations of ring_position (boundary_point's de Casteljau, or the
+ *              midpoint's halving, from the nearer end) and kind_eval's normal per lane
+ *              (surface_eval, then surface_normal as in rows_soa8).
  *   rows_soa8  a work-item per (patch, octet of rows): 8 rows walked at once in float8 lanes
  *              ("structure of arrays"), the operations of kind_row_next and surface_normal per
  *              lane (FP_CONTRACT off), so the same bits where cross, dot and length are
@@ -13,7 +17,9 @@
  *              double, dot by dpps); a lane whose normal needs a fall-back calls
  *              surface_normal itself.  Uniform rows only (every row pattern_row(f, 1) steps,
  *              the quad transition pattern's).  SINK_ONLY: no stores, one float per work-item
- *              (the arithmetic alone). */
+ *              (the arithmetic alone); STORE_LANES: the same bytes stored as whole float8
+ *              vectors, lane-major, into the same arrays (not the output's layout: what the
+ *              stores would cost after a transpose, the transpose left out). */
 #include "stages/rows.h"
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 
@@ -171,6 +177,14 @@ __kernel void rows_soa8(__global const float4 *controls, __global const int4 *fa
         }
 #ifdef SINK_ONLY
         sink += qx + qy + qz + ox + oy + oz;
+#elif defined(STORE_LANES)
+        /* the same bytes written as whole float8 vectors, lane-major (not the output's layout:
+         * what stores after a transpose would cost, the transpose left out) */
+        ulong at = min(8 * (at0 / 8 + (ulong)(i - 1)), (vertex_offsets[first_patch + num_patches] - vertex_base) / 8 * 8 - 8);
+        vstore8(qx, 3 * at / 8, positions); vstore8(qy, 3 * at / 8 + 1, positions); vstore8(qz, 3 * at / 8 + 2, positions);
+        vstore8(ox, 3 * at / 8, normals); vstore8(oy, 3 * at / 8 + 1, normals); vstore8(oz, 3 * at / 8 + 2, normals);
+        vstore8((float8)(x0.x), 2 * at / 8, uv); vstore8(row_v, 2 * at / 8 + 1, uv);
+        vstore8((int8)((int)p), at / 8, patch_ids); vstore8((int8)(object), at / 8, object_ids);
 #else
         ulong at = at0 + (ulong)(i - 1);
         for (int k = 0; k < lanes; ++k, at += (ulong)(steps - 1)) {  /* lane k's vertex: a scatter */
@@ -190,4 +204,132 @@ __kernel void rows_soa8(__global const float4 *controls, __global const int4 *fa
 #ifdef SINK_ONLY
     positions[item] = sink.s0 + sink.s1 + sink.s2 + sink.s3 + sink.s4 + sink.s5 + sink.s6 + sink.s7;
 #endif
+}
+
+/* The unit normal of surface_normal from B, B_u, B_v in lanes (s*, u*, v*: their components);
+ * a lane that needs a fall-back gets surface_normal's own (at its (u, v)). */
+inline void normal_lanes(__private const kind_patch *patch, float8 u, float8 v, float8 sx, float8 sy, float8 sz,
+                         float8 sw, float8 sux, float8 suy, float8 suz, float8 suw, float8 svx, float8 svy,
+                         float8 svz, float8 svw, int lanes, float8 *ox, float8 *oy, float8 *oz)
+{
+    float8 px = sx / sw, py = sy / sw, pz = sz / sw;
+    float8 ux = sux - suw * px, uy = suy - suw * py, uz = suz - suw * pz;
+    float8 vx = svx - svw * px, vy = svy - svw * py, vz = svz - svw * pz;
+    float8 nx = cross_lanes(uy, vz, uz, vy), ny = cross_lanes(uz, vx, ux, vz), nz = cross_lanes(ux, vy, uy, vx);
+    float8 scale = dot_lanes(ux, uy, uz, ux, uy, uz) + dot_lanes(vx, vy, vz, vx, vy, vz);
+    int8 ok = dot_lanes(nx, ny, nz, nx, ny, nz) > NORMAL_DEGENERATE * NORMAL_DEGENERATE * scale * scale;
+    float8 len = length_lanes(nx, ny, nz);
+    int8 positive = len > 0.0f;
+    *ox = select((float8)(0.0f), nx / len, positive);
+    *oy = select((float8)(0.0f), ny / len, positive);
+    *oz = select((float8)(1.0f), nz / len, positive);
+    int8 fall_back = ~ok;
+    if (any(fall_back))
+        for (int k = 0; k < lanes; ++k)
+            if (((int *)&fall_back)[k]) {
+                float4 s = (float4)(LANE(sx, k), LANE(sy, k), LANE(sz, k), LANE(sw, k));
+                float4 s_u = (float4)(LANE(sux, k), LANE(suy, k), LANE(suz, k), LANE(suw, k));
+                float4 s_v = (float4)(LANE(svx, k), LANE(svy, k), LANE(svz, k), LANE(svw, k));
+                float3 normal = surface_normal(patch->t, LANE(u, k), LANE(v, k), s, s_u, s_v);
+                LANE(*ox, k) = normal.x;
+                LANE(*oy, k) = normal.y;
+                LANE(*oz, k) = normal.z;
+            }
+}
+
+/* Component c of a float4 */
+#define COMP(a, c) ((c) == 0 ? (a).x : (c) == 1 ? (a).y : (c) == 2 ? (a).z : (a).w)
+
+__kernel void ring_soa8(__global const float4 *controls, __global const int4 *factors,
+                        __global const ulong *vertex_offsets, __global const int *patch_objects,
+                        uint first_patch, uint num_patches, uint patch_base, ulong vertex_base,
+                        int forward_differencing, uint octets,
+                        __global float *positions, __global float *normals, __global float *uv,
+                        __global int *patch_ids, __global int *object_ids)
+{
+    size_t item = get_global_id(0);
+    uint q = (uint)(item / (4 * octets));
+    int e = (int)(item / octets % 4), octet = (int)(item % octets);
+    if (q >= num_patches)
+        return;
+    uint p = first_patch + q;
+    int collapsed;
+    int4 f = patch_factors(factors[p], &collapsed);
+    int count = PATTERN_EDGE_POINTS(f, e), first = 8 * octet;
+    if (f.s0 <= 0 || first >= count)
+        return;
+    int lanes = min(8, count - first), object = patch_objects[p];
+    kind_patch patch;
+    kind_load(controls, p - patch_base, &patch);
+    ulong at = vertex_offsets[p] - vertex_base + (ulong)first;
+    for (int edge = 0; edge < e; ++edge)
+        at += (ulong)PATTERN_EDGE_POINTS(f, edge);
+    int fe = factor_of(f, e);
+    /* lane k: point first + k of the edge (ring_position, whole factors) */
+    float8 near_s, t_loc;
+    int8 forward, middle, corner;
+    for (int k = 0; k < 8; ++k) {
+        int point = first + min(k, lanes - 1);
+        edge_param t = pattern_ring_param(f, e, point);
+        int kk = (collapsed >> e) & 1 ? 0 : t.k;  /* a collapsed edge: its first corner */
+        int near = min(kk, t.f - kk);
+        LANE(near_s, k) = kk == 0 || 2 * kk == t.f ? 0.0f : (float)near / (float)t.f;
+        LANE(t_loc, k) = edge_location(t);
+        ((int *)&forward)[k] = 2 * kk < t.f ? -1 : 0;
+        ((int *)&middle)[k] = 2 * kk == t.f ? -1 : 0;
+        ((int *)&corner)[k] = kk == 0 ? -1 : 0;
+    }
+    /* boundary_point on edge e's controls, component by component */
+    float8 h[4];
+    for (int c = 0; c < 4; ++c) {
+        float8 qv[4];
+        for (int i = 0; i < 4; ++i)
+            qv[i] = select((float8)(COMP(patch.edges[e][3 - i], c)), (float8)(COMP(patch.edges[e][i], c)), forward);
+        float8 m[4] = {qv[0], qv[1], qv[2], qv[3]}, l[4] = {qv[0], qv[1], qv[2], qv[3]};
+        for (int level = 3; level > 0; --level)
+            for (int i = 0; i < level; ++i) {
+                m[i] = (m[i] + m[i + 1]) * 0.5f;
+                l[i] = l[i] + near_s * (l[i + 1] - l[i]);
+            }
+        h[c] = select(select(l[0], m[0], middle), (float8)(COMP(patch.edges[e][0], c)), corner);
+    }
+    float8 qx = h[0] / h[3], qy = h[1] / h[3], qz = h[2] / h[3];
+    /* the domain point (quad_edge_point) */
+    float8 u = e == 0 ? t_loc : e == 1 ? (float8)(1.0f) : e == 2 ? 1.0f - t_loc : (float8)(0.0f);
+    float8 v = e == 0 ? (float8)(0.0f) : e == 1 ? t_loc : e == 2 ? (float8)(1.0f) : 1.0f - t_loc;
+    /* surface_eval: row_controls at v, then the u direction */
+    float8 sv = 1.0f - v;
+    float8 bv0 = sv * sv * sv, bv1 = 3.0f * v * sv * sv, bv2 = 3.0f * v * v * sv, bv3 = v * v * v;
+    float8 dv0 = sv * sv, dv1 = 2.0f * v * sv, dv2 = v * v;
+    float8 su = 1.0f - u;
+    float8 bu0 = su * su * su, bu1 = 3.0f * u * su * su, bu2 = 3.0f * u * u * su, bu3 = u * u * u;
+    float8 du0 = su * su, du1 = 2.0f * u * su, du2 = u * u;
+    float8 s[4], s_u[4], s_v[4];
+    for (int c = 0; c < 4; ++c) {
+        float8 cc[4], dd[4];
+        for (int i = 0; i < 4; ++i) {
+            float b0 = COMP(patch.t[i], c), b1 = COMP(patch.t[4 + i], c), b2 = COMP(patch.t[8 + i], c),
+                  b3 = COMP(patch.t[12 + i], c);
+            cc[i] = bv0 * b0 + bv1 * b1 + bv2 * b2 + bv3 * b3;
+            dd[i] = 3.0f * (dv0 * (b1 - b0) + dv1 * (b2 - b1) + dv2 * (b3 - b2));
+        }
+        s[c] = bu0 * cc[0] + bu1 * cc[1] + bu2 * cc[2] + bu3 * cc[3];
+        s_u[c] = 3.0f * (du0 * (cc[1] - cc[0]) + du1 * (cc[2] - cc[1]) + du2 * (cc[3] - cc[2]));
+        s_v[c] = bu0 * dd[0] + bu1 * dd[1] + bu2 * dd[2] + bu3 * dd[3];
+    }
+    float8 ox, oy, oz;
+    normal_lanes(&patch, u, v, s[0], s[1], s[2], s[3], s_u[0], s_u[1], s_u[2], s_u[3], s_v[0], s_v[1], s_v[2],
+                 s_v[3], lanes, &ox, &oy, &oz);
+    for (int k = 0; k < lanes; ++k, ++at) {
+        positions[3 * at] = LANE(qx, k);
+        positions[3 * at + 1] = LANE(qy, k);
+        positions[3 * at + 2] = LANE(qz, k);
+        normals[3 * at] = LANE(ox, k);
+        normals[3 * at + 1] = LANE(oy, k);
+        normals[3 * at + 2] = LANE(oz, k);
+        uv[2 * at] = LANE(u, k);
+        uv[2 * at + 1] = LANE(v, k);
+        patch_ids[at] = (int)p;
+        object_ids[at] = object;
+    }
 }

@@ -88,8 +88,8 @@ inline uint pattern_grid_index(pattern_grid g, int2 point)
  * collapsed edge (bit e of collapsed) joins two coincident points and is left out.  A cell of
  * the inner grid (no corner on the ring) takes its corners' numbers directly: inner point
  * (i, j) is ring + (j - 1)(A - 1) + (i - 1) (pattern_grid_index), so its row neighbour is + 1
- * and the point above it + (A - 1); the same numbers as pattern_grid_index, a third less work
- * in stage 5 on a CPU (bench/RESULTS.md, "Issue 15: CPU stage bandwidth"). */
+ * and the point above it + (A - 1); the same numbers as pattern_grid_index, with less work
+ * (stage 5 on CPUs: bench/RESULTS.md, "Issue 15: CPU stage bandwidth"). */
 inline void grid_cells(__global uint *out, uint *count, uint base, pattern_grid g, int collapsed,
                        int i0, int i1, int j0, int j1)
 {
