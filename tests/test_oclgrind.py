@@ -192,6 +192,7 @@ def test_scenarios_reach_every_code_path(oclgrind, tmp_path_factory):
     ring = visible[~uniform]
     assert (uniform & (visible.max(axis=1) > 1)).any(), "a uniform grid"
     assert (uniform & (visible.max(axis=1) == 1)).any(), "a patch with all factors 1"
+    assert (uniform & (visible[:, :2].min(axis=1) > 2)).any(), "a uniform grid with inner cells (grid_cells)"
     pairs_differ = (ring[:, 0] != ring[:, 2]).astype(int) + (ring[:, 1] != ring[:, 3])
     assert (pairs_differ == 1).any() and (pairs_differ == 2).any(), "one and two transition directions"
     assert (ring.min(axis=1) == 1).any(), "a ring pattern whose core is clamped up to 2"

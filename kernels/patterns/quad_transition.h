@@ -85,12 +85,23 @@ inline uint pattern_grid_index(pattern_grid g, int2 point)
 #include "patterns/stitch.h"
 
 /* Cells i0..i1-1 x j0..j1-1 of the grid, two triangles each; a triangle with a side on a
- * collapsed edge (bit e of collapsed) joins two coincident points and is left out. */
+ * collapsed edge (bit e of collapsed) joins two coincident points and is left out.  A cell of
+ * the inner grid (no corner on the ring) takes its corners' numbers directly: inner point
+ * (i, j) is ring + (j - 1)(A - 1) + (i - 1) (pattern_grid_index), so its row neighbour is + 1
+ * and the point above it + (A - 1); the same numbers as pattern_grid_index, with less work
+ * (stage 5 on CPUs: bench/RESULTS.md, "Issue 15: CPU stage bandwidth"). */
 inline void grid_cells(__global uint *out, uint *count, uint base, pattern_grid g, int collapsed,
                        int i0, int i1, int j0, int j1)
 {
+    uint ring = (uint)(g.f.s0 + g.f.s1 + g.f.s2 + g.f.s3), inner = (uint)(g.core.x - 1);
     for (int j = j0; j < j1; ++j)
         for (int i = i0; i < i1; ++i) {
+            if (j > 0 && j + 1 < g.core.y && i > 0 && i + 1 < g.core.x) {
+                uint a = ring + (uint)(j - 1) * inner + (uint)(i - 1), d = a + inner;
+                put_triangle(out, count, base, a, a + 1, d + 1);  /* (a, b, c) */
+                put_triangle(out, count, base, a, d + 1, d);      /* (a, c, d) */
+                continue;
+            }
             uint a = pattern_grid_index(g, (int2)(i, j)), b = pattern_grid_index(g, (int2)(i + 1, j));
             uint c = pattern_grid_index(g, (int2)(i + 1, j + 1)), d = pattern_grid_index(g, (int2)(i, j + 1));
             if (!((j == 0 && (collapsed & 1)) || (i + 1 == g.core.x && (collapsed & 2))))

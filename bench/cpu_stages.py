@@ -1,0 +1,222 @@
+"""Issue 15, the CPU line: what bounds stages 4-5 on a CPU device, measured in one process.
+
+    python bench/cpu_stages.py [--device pocl] [--copies 1000] [--repeat 5] [--baseline-kernels DIR]
+                               [--json out.json]
+
+Uniform level 16 (``frame_loop.teapots``: 1,000 teapots, 32,000 patches, every edge factor
+16; 16.3 M triangles, 565 MB written), stages 1-3 planned once by the engine, then on the same
+plan's device buffers, each kernel launched alone ``--repeat`` times:
+
+* **fill**: the plain fill kernel of ``bench/frame_loop.py`` over a buffer of the output's size
+  (565 MB): the memory-write rate;
+* **stage 4** (the engine's ``vertices``, a work-item per patch) and **stage 5** (``indices``);
+* probes of stage 4 (``bench/kernels/cpu_stage4_probe.cl``): the ring alone and the interior
+  rows alone (the engine's own ``put_ring`` / ``put_rows``), the ring 8 points at a time in
+  float8 lanes (``ring_soa8``), and the rows 8 at a time in float8
+  lanes (``rows_soa8``, with Intel's builtin forms, on Intel's runtime only: PoCL 3.0 crashed
+  running it), with its stores, with the same bytes stored as whole float8 vectors (not the
+  output's layout: what the stores would cost after a transpose) and without stores;
+  ring + rows, ring + rows_soa8 and ring_soa8 + rows_soa8 are hashed against the engine's stage 4
+  ("same bits");
+* with ``--baseline-kernels DIR`` (a kernels/ folder of another tree, e.g. ``git archive`` of
+  main), its stage 4 and 5 built from there too, side by side.
+
+Two clocks per launch: the device time (OpenCL profiling span: wall time on the runtime's
+threads, which this shared VM's load stretches) and the **process CPU time** (``getrusage``:
+user + system seconds of every thread of this process, the runtime's worker threads included)
+over the launch and its wait: the work done, much less disturbed by other processes' load.
+Each figure: the minimum over the repeats (and the median).  "% of fill" = the fill kernel's
+time for the bytes a kernel writes (565 MB for stages 4 + 5; 40 bytes a vertex, 4 an index) /
+the kernel's time: by device time and by CPU time.
+"""
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import os
+import resource
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pyopencl as cl
+import pyopencl.array as cl_array
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import frame_loop  # noqa: E402  (teapots, uniform_request, FILL_SOURCE)
+
+from cltess.backends.opencl import Tessellator  # noqa: E402
+from cltess.backends.opencl.programs import composition, correctly_rounded_division, kernel_dir  # noqa: E402
+from cltess.bench.suite import device_info, machine_info  # noqa: E402
+from cltess.kinds import BEZIER  # noqa: E402
+from cltess.tessellation import VERTEX_RECORD  # noqa: E402
+
+PROBE = Path(__file__).resolve().parent / "kernels" / "cpu_stage4_probe.cl"
+
+
+def cpu_seconds() -> float:
+    usage = resource.getrusage(resource.RUSAGE_SELF)
+    return usage.ru_utime + usage.ru_stime
+
+
+def timed(launch, repeat: int) -> dict:
+    """Device ms and process CPU ms of ``launch()`` (returns an event), each repeat waited."""
+    device, cpu = [], []
+    for _ in range(repeat):
+        started = cpu_seconds()
+        event = launch()
+        event.wait()
+        cpu.append((cpu_seconds() - started) * 1e3)
+        device.append((event.profile.end - event.profile.start) * 1e-6)
+    return {"device_ms": min(device), "device_ms_median": statistics.median(device),
+            "cpu_ms": min(cpu), "cpu_ms_median": statistics.median(cpu)}
+
+
+def build(context, device, folder: Path, stage_source: str, stage: str, pattern, defines=()) -> cl.Program:
+    headers, _ = composition(stage, kind=BEZIER, pattern=pattern)
+    source = "".join(f'#include "{header}"\n' for header in ("common.h", *headers))
+    source += "".join(f"#define {d}\n" for d in defines) + stage_source
+    options = ["-I", str(folder)] + correctly_rounded_division(device)
+    return cl.Program(context, source).build(options=options)
+
+
+def digest(arrays) -> str:
+    hashed = hashlib.blake2b(digest_size=8)
+    for array in arrays:
+        hashed.update(array.get().tobytes())
+    return hashed.hexdigest()
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--device", help="OpenCL device (substring; default as cltess picks)")
+    parser.add_argument("--copies", type=int, default=1000, help="teapots (32 patches each)")
+    parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--baseline-kernels", help="a kernels/ folder to build stages 4-5 from too")
+    parser.add_argument("--json")
+    args = parser.parse_args(argv)
+
+    tessellator = Tessellator(args.device, work="patch")
+    context, queue, device = tessellator.context, tessellator.queue, tessellator.device
+    intel = "Intel" in device.platform.name
+    record = {"device": device_info(device), "machine": machine_info(), "command": " ".join(sys.argv),
+              "date": time.strftime("%Y-%m-%d %H:%M:%S %z"), "load_before": [round(x, 1) for x in os.getloadavg()]}
+    scene = frame_loop.teapots(args.copies)
+    plan = tessellator.plan(scene, **frame_loop.uniform_request(16))
+    part = plan.parts[0]
+    patches, vertices = plan.num_patches, plan.num_vertices
+    output_bytes = vertices * 40 + plan.num_indices * 4
+    record.update(patches=patches, vertices=vertices, triangles=plan.num_indices // 3, output_bytes=output_bytes)
+    out = [cl_array.empty(queue, (vertices, *shape), dtype) for _, dtype, shape in VERTEX_RECORD]
+    triangles = cl_array.empty(queue, (plan.num_indices,), np.uint32)
+    common = (part.data["controls"].data, plan.factors.data, plan.vertex_offsets.data, plan.objects.data,
+              np.uint32(0), np.uint32(patches), np.uint32(0), np.uint64(0), np.int32(1))
+    per_patch = (-(-patches // 64) * 64,)
+    buffers = [a.data for a in out]
+
+    fill = cl.Program(context, frame_loop.FILL_SOURCE).build().fill
+    count = output_bytes // 16
+    fill_buffer = cl.Buffer(context, cl.mem_flags.READ_WRITE, count * 16)
+    rows = {}
+
+    def measure(name, launch):
+        rows[name] = timed(launch, args.repeat)
+        print(f"{name}: device {rows[name]['device_ms']:.1f} ms (median {rows[name]['device_ms_median']:.1f}), "
+              f"CPU {rows[name]['cpu_ms']:.0f} ms (median {rows[name]['cpu_ms_median']:.0f})", file=sys.stderr, flush=True)
+
+    folders = [("", kernel_dir())] + ([("baseline ", Path(args.baseline_kernels))] if args.baseline_kernels else [])
+    kernels = {}
+    for label, folder in folders:
+        kernels[label] = (
+            build(context, device, folder, (folder / "stages" / "vertices.cl").read_text(), "vertices", part.pattern).vertices,
+            build(context, device, folder, (folder / "stages" / "indices.cl").read_text(), "indices", part.pattern).indices)
+    forms = ("INTEL_FORMS",) if intel else ()
+    probe_source = PROBE.read_text()
+    probe = build(context, device, kernel_dir(), probe_source, "vertices", part.pattern, forms)
+    sink = build(context, device, kernel_dir(), probe_source, "vertices", part.pattern, forms + ("SINK_ONLY",))
+    lanes_stored = build(context, device, kernel_dir(), probe_source, "vertices", part.pattern, forms + ("STORE_LANES",))
+    octets = (16 - 1 + 7) // 8  # rows of a level-16 patch, 8 per work-item
+
+    def launch_stage4(kernel):
+        return lambda: kernel(queue, per_patch, None, *common, *buffers)
+
+    for rep in range(2):  # two rounds, interleaved, so that the load's drift touches every figure
+        suffix = "" if rep == 0 else " (again)"
+        measure("fill" + suffix, lambda: fill(queue, (-(-count // 256) * 256,), (256,), fill_buffer,
+                                              np.zeros(4, np.float32), np.uint64(count)))
+        for label, (vertices_kernel, indices_kernel) in kernels.items():
+            measure(f"{label}stage 4 (vertices){suffix}", launch_stage4(vertices_kernel))
+            record.setdefault("digests", {})[f"{label}stage 4"] = digest(out)
+            measure(f"{label}stage 5 (indices){suffix}", lambda: indices_kernel(
+                queue, per_patch, None, plan.factors.data, plan.vertex_offsets.data, plan.index_offsets.data,
+                np.uint32(0), np.uint32(patches), np.uint64(0), triangles.data))
+            record["digests"][f"{label}stage 5"] = digest([triangles])
+        for buffer in buffers:
+            cl.enqueue_fill_buffer(queue, buffer, np.zeros(1, np.uint8), 0, buffer.size)
+        measure(f"ring only{suffix}", launch_stage4(probe.ring_only))
+        measure(f"rows only{suffix}", launch_stage4(probe.rows_only))
+        record["digests"]["ring + rows"] = digest(out)
+        if not intel:  # PoCL 3.0 crashed (SIGSEGV) running rows_soa8 here; its builtins' forms are not known
+            continue
+        measure(f"rows, 8 in float8 lanes{suffix}", lambda: probe.rows_soa8(
+            queue, (-(-patches * octets // 64) * 64,), None, *common, np.uint32(octets), *buffers))
+        record["digests"]["ring + rows_soa8"] = digest(out)
+        measure(f"ring, 8 points in float8 lanes{suffix}", lambda: probe.ring_soa8(
+            queue, (-(-patches * 4 * 2 // 64) * 64,), None, *common, np.uint32(2), *buffers))
+        record["digests"]["ring_soa8 + rows_soa8"] = digest(out)
+        measure(f"rows, 8 in float8 lanes, stored as float8{suffix}", lambda: lanes_stored.rows_soa8(
+            queue, (-(-patches * octets // 64) * 64,), None, *common, np.uint32(octets), *buffers))
+        measure(f"rows, 8 in float8 lanes, no stores{suffix}", lambda: sink.rows_soa8(
+            queue, (-(-patches * octets // 64) * 64,), None, *common, np.uint32(octets), *buffers))
+    record["figures"] = rows
+    record["load_after"] = [round(x, 1) for x in os.getloadavg()]
+
+    def best(name, key):
+        return min(rows[n][key] for n in rows if n == name or n == name + " (again)")
+
+    fill_device, fill_cpu = best("fill", "device_ms"), best("fill", "cpu_ms")
+    lines = [f"{record['device']}; {patches:,} patches, {vertices:,} vertices, {plan.num_indices // 3:,} triangles, "
+             f"{output_bytes / 1e6:.0f} MB; load {record['load_before']} -> {record['load_after']}; "
+             f"fill {output_bytes / fill_device / 1e6:.1f} GB/s by device time", "",
+             "| kernel | MB it writes | device ms (min) | CPU ms (min) | % of fill, device | % of fill, CPU |",
+             "|---|---|---|---|---|---|"]
+    ring_vertices = patches * 64  # 4 edges of 16 points a patch
+    written = {"fill": output_bytes, "stage 4 (vertices)": vertices * 40, "stage 5 (indices)": plan.num_indices * 4,
+               "ring only": ring_vertices * 40, "rows only": (vertices - ring_vertices) * 40,
+               "rows, 8 in float8 lanes": (vertices - ring_vertices) * 40,
+               "rows, 8 in float8 lanes, stored as float8": (vertices - ring_vertices) * 40,
+               "ring, 8 points in float8 lanes": ring_vertices * 40}
+    for label in kernels:
+        written[f"{label}stage 4 (vertices)"] = written["stage 4 (vertices)"]
+        written[f"{label}stage 5 (indices)"] = written["stage 5 (indices)"]
+    names = [n for n in rows if not n.endswith("(again)")]
+    for name in names:  # % of fill: the fill kernel's time for the bytes this kernel writes / its time
+        device_ms, cpu_ms = best(name, "device_ms"), best(name, "cpu_ms")
+        size = written.get(name)
+        share = "" if size is None else (f"{100 * fill_device * size / output_bytes / device_ms:.0f}% | "
+                                         f"{100 * fill_cpu * size / output_bytes / cpu_ms:.0f}%")
+        lines.append(f"| {name} | {'' if size is None else f'{size / 1e6:.0f}'} | {device_ms:.1f} | {cpu_ms:.0f} | "
+                     f"{share or ' | '} |")
+    for label in kernels:
+        device_ms = best(f"{label}stage 4 (vertices)", "device_ms") + best(f"{label}stage 5 (indices)", "device_ms")
+        cpu_ms = best(f"{label}stage 4 (vertices)", "cpu_ms") + best(f"{label}stage 5 (indices)", "cpu_ms")
+        lines.append(f"| {label}stages 4 + 5 | {output_bytes / 1e6:.0f} | {device_ms:.1f} | {cpu_ms:.0f} | "
+                     f"{100 * fill_device / device_ms:.1f}% | {100 * fill_cpu / cpu_ms:.1f}% |")
+    lines += ["", "bits: " + ", ".join(f"{k} {v}" for k, v in record["digests"].items())]
+    same = record["digests"]["stage 4"]
+    soa8 = record["digests"].get("ring + rows_soa8")
+    lines.append(f"ring + rows same bits as stage 4: {'yes' if record['digests']['ring + rows'] == same else 'NO'}; "
+                 f"ring + rows_soa8 (Intel's forms): "
+                 f"{'not run (Intel only)' if soa8 is None else 'yes' if soa8 == same else 'NO'}; "
+                 f"ring_soa8 + rows_soa8: {'not run' if soa8 is None else 'yes' if record['digests']['ring_soa8 + rows_soa8'] == same else 'NO'}")
+    print("\n".join(lines))
+    if args.json:
+        Path(args.json).write_text(json.dumps(record, indent=1, default=float) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
