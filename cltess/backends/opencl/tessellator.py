@@ -73,8 +73,11 @@ DEFAULT_WORK = {"gpu": "point", "other": "patch"}
 #: Stage 3 in one launch per range of patches (stages/offsets.cl: counts and the scan by one
 #: work-group) up to this many patches; more go through the counts kernel and pyopencl.scan.  On
 #: the H100 one launch took 0.03 ms against the scans' 0.14-0.25 ms up to 1,536 patches, 0.17
-#: against 0.14 at 11,532 and 0.71 against 0.19 at 32,000 (bench/RESULTS.md, issue 15 on the H100).
-FUSED_OFFSETS_MAX_PATCHES = 1 << 13
+#: against 0.14 at 11,532 and 0.71 against 0.19 at 32,000 (bench/RESULTS.md, issue 15 on the H100);
+#: at 11,532 (killeroo) it still wins a frame: the device's 0.06 ms more against 0.15 ms less
+#: of the host's (the scans' allocations and three launches), 0.320 against 0.458 ms per
+#: overlapped frame (bench/RESULTS.md, "Session 4 on the H100").
+FUSED_OFFSETS_MAX_PATCHES = 1 << 14
 #: The same on a CPU device (one work-group runs on one core): measured on Intel's runtime and PoCL
 #: (2 vCPUs), a frame took 0.1 ms less fused than with the counts kernel and pyopencl.scan at 332
 #: and 1,536 patches (mostly the scan's host cost: two temporary arrays and three launches per call),
