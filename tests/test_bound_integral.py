@@ -68,7 +68,7 @@ def test_subpatch_majorants_hold_and_pyramid_bounds_them(rng):
 def test_kernel_matches_the_numpy_mirror(tessellator, rng, subdivisions):
     patches = random_patches(rng, 3)
     pyramids, index = integral.scene_pyramids(patches, np.ones(3, bool), LEVELS)
-    cells = integral.pyramid_cells(LEVELS)
+    cells = integral.table_cells(LEVELS)
     count = 30
     corners = rng.uniform(0, 1, (count, 3, 2)).astype(np.float32)
     corners[:8] *= rng.uniform(0.02, 0.3, (8, 1, 1)).astype(np.float32)  # small, near a corner
