@@ -16,7 +16,7 @@
 #define INTEGRAL_BOX_WIDENING 1e-6f  /* integral.BOX_WIDENING: float32 rounding of a box's corners */
 #define INTEGRAL_QUERY_SPAN 4        /* integral.QUERY_SPAN: cells per side looked at, at most */
 #define INTEGRAL_BOUND_SAFETY 1.0001f  /* integral.BOUND_SAFETY: the float32 sums' rounding */
-#define INTEGRAL_GRADED_SPAN 4       /* integral.GRADED_SPAN: graded cells per side looked at, fewer than */
+#define INTEGRAL_GRADED_SPAN 8       /* integral.GRADED_SPAN: graded cells per side looked at, fewer than */
 
 /* The graded cell holding x: the largest k in [0, count) with breaks[k] <= x (breaks[0] = 0). */
 inline int integral_graded_cell(__global const float *breaks, int count, float x)
