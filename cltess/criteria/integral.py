@@ -191,10 +191,19 @@ def rounded_up(values: np.ndarray) -> np.ndarray:
 
 def patch_table(patch: np.ndarray, levels: int = SUBPATCH_LEVELS) -> np.ndarray:
     """(table_cells, 4) float32 of one patch: majorant_pyramid, then the graded cells' (m_uu,
-    m_uv, m_vv, 0) row by row (v, then u), rounded up likewise."""
-    graded = cell_majorants(patch, graded_breaks(levels))
+    m_uv, m_vv, 0) row by row (v, then u), rounded up likewise.  Only the graded cells are
+    subdivided: they nest in the S x S subpatches (the breakpoints include every multiple of
+    1/S), so a subpatch's majorant is taken as the max of its graded cells' (each a valid
+    majorant on its cell, and no larger than the subpatch's own hull bound: a restriction's
+    control points are convex combinations of the whole's)."""
+    breaks = graded_breaks(levels)
+    graded = cell_majorants(patch, breaks)
+    side = 1 << levels
+    owner = np.floor(breaks[:-1] * side).astype(int)  # the subpatch holding each graded cell, per axis
+    subpatches = np.zeros((side, side, 3))
+    np.maximum.at(subpatches, (owner[:, None], owner[None, :]), graded)
     out = np.zeros((table_cells(levels), 4), np.float32)
-    out[:pyramid_cells(levels)] = majorant_pyramid(subpatch_majorants(patch, levels))
+    out[:pyramid_cells(levels)] = majorant_pyramid(subpatches)
     out[pyramid_cells(levels):, :3] = rounded_up(graded.reshape(-1, 3))
     return out
 
