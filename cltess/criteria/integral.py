@@ -239,12 +239,16 @@ def scene_pyramids(patches: np.ndarray, rational: np.ndarray, levels: int = SUBP
 
 def pyramid_query(pyramid: np.ndarray, levels: int, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     """(3,) max of (m_uu, m_uv, m_vv) over the cells of one patch's table (patch_table) that the
-    box [lo, hi] (u, v in [0, 1], widened by BOX_WIDENING) meets: the graded cells if it meets
-    fewer than GRADED_SPAN per side, else the pyramid at the finest level where it spans at most
+    box [lo, hi] (u, v in [0, 1], widened by BOX_WIDENING) meets: the graded cells if it comes
+    within 4 / S of an edge (elsewhere they are the finest subpatches) and meets fewer than
+    GRADED_SPAN of them per side, else the pyramid at the finest level where it spans at most
     QUERY_SPAN cells per side (float32 arithmetic as the kernel's).  A pyramid alone (no graded
     rows) reads the pyramid."""
     w = np.float32(BOX_WIDENING)
-    if len(pyramid) > pyramid_cells(levels):
+    edge = np.float32(4) / np.float32(1 << levels)  # graded cells finer than the subpatches only there
+    near_edge = (min(np.float32(lo[0]), np.float32(lo[1])) - w < edge
+                 or max(np.float32(hi[0]), np.float32(hi[1])) + w > np.float32(1) - edge)
+    if len(pyramid) > pyramid_cells(levels) and near_edge:
         breaks = graded_breaks(levels).astype(np.float32)
         count = len(breaks) - 1
         cell = lambda x: min(max(int(np.searchsorted(breaks, x, side="right")) - 1, 0), count - 1)  # noqa: E731

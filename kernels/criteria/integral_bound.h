@@ -34,15 +34,23 @@ inline int integral_graded_cell(__global const float *breaks, int count, float x
 
 /* max of (m_uu, m_uv, m_vv) over the cells of a patch's table (integral.patch_table: its pyramid,
  * then count x count graded cells on the breakpoints `breaks`) that the box [lo, hi] meets: the
- * graded cells when it meets fewer than INTEGRAL_GRADED_SPAN per side, else the pyramid at the
+ * graded cells when it comes within 4/S of an edge and meets fewer than INTEGRAL_GRADED_SPAN of
+ * them per side, else the pyramid at the
  * finest level where it spans at most INTEGRAL_QUERY_SPAN cells per side. */
 inline float3 integral_query(__global const float4 *pyramid, int levels, __global const float *breaks, int count,
                              float2 lo, float2 hi)
 {
-    int gi0 = integral_graded_cell(breaks, count, lo.x - INTEGRAL_BOX_WIDENING);
-    int gj0 = integral_graded_cell(breaks, count, lo.y - INTEGRAL_BOX_WIDENING);
-    int gi1 = integral_graded_cell(breaks, count, hi.x + INTEGRAL_BOX_WIDENING);
-    int gj1 = integral_graded_cell(breaks, count, hi.y + INTEGRAL_BOX_WIDENING);
+    /* the graded cells are finer than the finest subpatches only within 4/S of an edge */
+    float edge = 4.0f / (float)(1 << levels);
+    int near_edge = fmin(lo.x, lo.y) - INTEGRAL_BOX_WIDENING < edge
+                 || fmax(hi.x, hi.y) + INTEGRAL_BOX_WIDENING > 1.0f - edge;
+    int gi0 = 0, gj0 = 0, gi1 = count, gj1 = count;
+    if (near_edge) {
+        gi0 = integral_graded_cell(breaks, count, lo.x - INTEGRAL_BOX_WIDENING);
+        gj0 = integral_graded_cell(breaks, count, lo.y - INTEGRAL_BOX_WIDENING);
+        gi1 = integral_graded_cell(breaks, count, hi.x + INTEGRAL_BOX_WIDENING);
+        gj1 = integral_graded_cell(breaks, count, hi.y + INTEGRAL_BOX_WIDENING);
+    }
     if (gi1 - gi0 < INTEGRAL_GRADED_SPAN && gj1 - gj0 < INTEGRAL_GRADED_SPAN) {
         __global const float4 *graded = pyramid + ((1 << (2 * levels + 2)) - 1) / 3;
         float3 g = (float3)(0.0f);
