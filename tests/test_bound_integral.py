@@ -43,6 +43,7 @@ def test_host_and_device_constants_agree():
     assert float(define("INTEGRAL_BOX_WIDENING")) == integral.BOX_WIDENING
     assert int(define("INTEGRAL_QUERY_SPAN")) == integral.QUERY_SPAN
     assert np.float32(define("INTEGRAL_BOUND_SAFETY")) == np.float32(integral.BOUND_SAFETY)
+    assert int(define("INTEGRAL_GRADED_SPAN")) == integral.GRADED_SPAN
     k = integral.SUBDIVISIONS  # the kernel doubles K from the first to the last
     assert all(b == 2 * a for a, b in zip(k, k[1:]))
 
