@@ -43,6 +43,7 @@ def test_host_and_device_constants_agree():
     assert float(define("INTEGRAL_BOX_WIDENING")) == integral.BOX_WIDENING
     assert int(define("INTEGRAL_QUERY_SPAN")) == integral.QUERY_SPAN
     assert np.float32(define("INTEGRAL_BOUND_SAFETY")) == np.float32(integral.BOUND_SAFETY)
+    assert int(define("INTEGRAL_GRADED_SPAN")) == integral.GRADED_SPAN
     k = integral.SUBDIVISIONS  # the kernel doubles K from the first to the last
     assert all(b == 2 * a for a, b in zip(k, k[1:]))
 
@@ -64,11 +65,71 @@ def test_subpatch_majorants_hold_and_pyramid_bounds_them(rng):
         assert np.allclose(pyramid[-1, :3], majorants.max(axis=(0, 1)), rtol=1e-5)  # the coarsest: the max
 
 
+@pytest.mark.parametrize("levels", [3, integral.SUBPATCH_LEVELS])
+def test_graded_breaks_are_dyadic_nested_and_graded(levels):
+    """The graded cells: exact in float32, symmetric, nested in the 2^levels subpatches, and each
+    cell beyond the innermost ones at most a quarter of its distance to the edge
+    (GRADED_OCTAVE_CELLS = 4)."""
+    breaks = integral.graded_breaks(levels)
+    assert breaks[0] == 0 and breaks[-1] == 1 and (np.diff(breaks) > 0).all()
+    assert (breaks.astype(np.float32).astype(float) == breaks).all()
+    assert np.array_equal(breaks, 1 - breaks[::-1])
+    assert set(np.arange((1 << levels) + 1) / (1 << levels)) <= set(breaks.tolist())
+    innermost = 2.0 ** -(levels + integral.GRADED_DEPTH)  # [0, innermost]: GRADED_OCTAVE_CELLS equal cells
+    left = np.flatnonzero((breaks[:-1] >= innermost) & (breaks[1:] <= 0.5))
+    assert (breaks[left + 1] - breaks[left] <= breaks[left] / integral.GRADED_OCTAVE_CELLS).all()
+    finest = 2.0 ** -(levels + integral.GRADED_DEPTH) / integral.GRADED_OCTAVE_CELLS
+    assert breaks[1] == finest and len(breaks) - 1 == integral.graded_count(levels)
+    assert integral.table_cells(levels) == integral.pyramid_cells(levels) + integral.graded_count(levels) ** 2
+
+
+def test_graded_cells_hold_and_the_table_is_no_looser(rng):
+    """Each graded cell's stored majorant bounds |p_ab| sampled densely in it (the corner cells,
+    where the spikes are, and random ones), and the table's pyramid is no larger than the direct
+    subpatch majorants' (it is pooled from the graded cells)."""
+    sys.path.insert(0, str(SCENES.parent / "bench"))
+    from ratio_floor import second_derivatives
+
+    levels = 3
+    breaks = integral.graded_breaks(levels)
+    count = len(breaks) - 1
+    for patch in random_patches(rng, 2):
+        table = integral.patch_table(patch, levels)
+        graded = table[integral.pyramid_cells(levels):, :3].reshape(count, count, 3).astype(float)
+        cells = [(0, 0), (count - 1, count - 1), (0, count - 1), (1, 2)] + [tuple(c) for c in rng.integers(0, count, (6, 2))]
+        for j, i in cells:
+            s_u = np.linspace(breaks[i], breaks[i + 1], 7)
+            s_v = np.linspace(breaks[j], breaks[j + 1], 7)
+            u, v = (x.ravel() for x in np.meshgrid(s_u, s_v))
+            found = np.array([np.linalg.norm(d, axis=1).max() for d in second_derivatives(patch, u, v)])
+            assert (found <= graded[j, i]).all(), (j, i)
+        direct = integral.majorant_pyramid(integral.subpatch_majorants(patch, levels))
+        assert (table[:integral.pyramid_cells(levels)] <= direct).all()
+
+
+def test_graded_tables_cut_the_corner_spike_patches(tessellator):
+    """bench/occ_compare.py's random patches 2 and 11 (a corner weight 0.3-0.4 among 3-5: curvature
+    ~ 1/distance^2 towards that corner) at eps = 1e-2 of the 20 patches' diagonal: with the graded
+    cells the integral bound needs under 0.3 of the hull bound's triangles (with the 64 x 64
+    pyramid alone: 0.95, 8,794 of 9,280), and the mesh is within eps."""
+    sys.path.insert(0, str(SCENES.parent / "bench"))
+    from occ_compare import diagonal, random_rational_patches
+
+    every = random_rational_patches()
+    patches = every[[2, 11]]
+    scene = Scene(patches, np.zeros(2, np.int32), name="corner spikes")
+    eps = 1e-2 * diagonal(every)
+    plan, hull = _integral_and_hull(tessellator, scene, eps)
+    assert plan.num_indices < 0.3 * hull.num_indices
+    tess = tessellator.emit(plan, 0, plan.num_patches)
+    assert dense_errors(patches, tess.positions, tess.uv, tess.patch_ids, tess.triangles, 6).max() <= eps
+
+
 @pytest.mark.parametrize("subdivisions", [(2,), (2, 4)])
 def test_kernel_matches_the_numpy_mirror(tessellator, rng, subdivisions):
     patches = random_patches(rng, 3)
     pyramids, index = integral.scene_pyramids(patches, np.ones(3, bool), LEVELS)
-    cells = integral.pyramid_cells(LEVELS)
+    cells = integral.table_cells(LEVELS)
     count = 30
     corners = rng.uniform(0, 1, (count, 3, 2)).astype(np.float32)
     corners[:8] *= rng.uniform(0.02, 0.3, (8, 1, 1)).astype(np.float32)  # small, near a corner

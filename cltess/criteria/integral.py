@@ -40,6 +40,18 @@ BOX_WIDENING = 1e-6
 #: A box query looks at no more than this many cells per side; a larger box is looked up on a
 #: coarser level of the pyramid (each level halves).
 QUERY_SPAN = 4
+#: The graded table (issue 9, session 4): besides the uniform pyramid, every patch keeps a
+#: tensor grid of cells that are the S x S subpatches in the middle and shrink geometrically
+#: towards the four edges (so towards the corners too), where the weights put curvature spikes
+#: that decay like 1/distance^2: each octave [2^-(k+1), 2^-k] of the distance to an edge, for
+#: 2^-k from 4/S down to 2^-(SUBPATCH_LEVELS + GRADED_DEPTH), is cut into GRADED_OCTAVE_CELLS
+#: cells, and the innermost [0, 2^-(SUBPATCH_LEVELS + GRADED_DEPTH)] too (finest cell 1/4096 at
+#: the defaults).  Breakpoints are dyadic, exact in float32 (graded_breaks).
+GRADED_DEPTH = 4
+GRADED_OCTAVE_CELLS = 4
+#: A box query reads the graded cells when the box meets fewer than this many per side, else
+#: the pyramid (both are majorants; the graded cells nest in the finest pyramid level's).
+GRADED_SPAN = 8
 #: The trial scales of today's factors (stage 1's (m, n)), in the order a patch tries them
 #: (factors only rise); the last one is today's bound itself (Lemmas 1/3: always certified).
 #: (0.78, 0.92, 0.96 added to a first list of ten: on the random patches 4% fewer triangles at
@@ -77,9 +89,16 @@ def subdivision_matrices(pieces: int, degree: int = 9) -> np.ndarray:
     """(pieces, degree + 1, degree + 1): M[s] maps a degree-``degree`` Bernstein net on [0, 1]
     to the net of its restriction to [s / pieces, (s + 1) / pieces] (de Casteljau: right part
     at a, then left part at (b - a) / (1 - a); float64)."""
-    out = np.empty((pieces, degree + 1, degree + 1))
-    for s in range(pieces):
-        a, b = s / pieces, (s + 1) / pieces
+    return interval_matrices(np.arange(pieces + 1) / pieces, degree)
+
+
+def interval_matrices(breaks: np.ndarray, degree: int = 9) -> np.ndarray:
+    """(len(breaks) - 1, degree + 1, degree + 1): M[s] maps a Bernstein net on [0, 1] to the net
+    of its restriction to [breaks[s], breaks[s + 1]] (as subdivision_matrices)."""
+    breaks = np.asarray(breaks, float)
+    out = np.empty((len(breaks) - 1, degree + 1, degree + 1))
+    for s in range(len(breaks) - 1):
+        a, b = breaks[s], breaks[s + 1]
         c = np.eye(degree + 1)  # columns: the unit nets
         if a > 0:  # right part at a: points c^(degree - r)_r
             rows, level = [c[-1]], c
@@ -101,10 +120,40 @@ def subdivision_matrices(pieces: int, degree: int = 9) -> np.ndarray:
 def subpatch_majorants(patch: np.ndarray, levels: int = SUBPATCH_LEVELS) -> np.ndarray:
     """(S, S, 3) float64 [v piece, u piece, (uu, uv, vv)], S = 2^levels: max_k |N_ab,k| / W_k of
     each subpatch's nets (Lemma 2 on the subpatch: |p_ab| <= that on it)."""
+    return cell_majorants(patch, np.arange((1 << levels) + 1) / (1 << levels))
+
+
+def graded_breaks(levels: int = SUBPATCH_LEVELS) -> np.ndarray:
+    """(G + 1,) float64 breakpoints of the graded cells along u (and v): uniform 2^-levels in
+    [4 / S, 1 - 4 / S], octaves of GRADED_OCTAVE_CELLS cells towards 0 and 1 (GRADED_DEPTH)."""
+    finest = levels + GRADED_DEPTH
+    q = GRADED_OCTAVE_CELLS
+    near = {j * 2.0 ** -finest / q for j in range(q + 1)}
+    for k in range(finest, levels - 2, -1):  # octave [2^-k, 2^-(k-1)]
+        near |= {2.0 ** -k * (1 + j / q) for j in range(q + 1)}
+    step = 2.0 ** -levels
+    middle = {i * step for i in range(4, (1 << levels) - 3)}
+    left = near | middle
+    return np.array(sorted(left | {1.0 - x for x in left}))
+
+
+def graded_count(levels: int = SUBPATCH_LEVELS) -> int:
+    """G: graded cells per side."""
+    return len(graded_breaks(levels)) - 1
+
+
+def table_cells(levels: int = SUBPATCH_LEVELS) -> int:
+    """float4 rows of one patch's table: its pyramid, then its G x G graded cells."""
+    return pyramid_cells(levels) + graded_count(levels) ** 2
+
+
+def cell_majorants(patch: np.ndarray, breaks: np.ndarray) -> np.ndarray:
+    """(G, G, 3) float64 [v cell, u cell, (uu, uv, vv)] of the tensor cells [breaks[i], breaks[i + 1]]
+    x [breaks[j], breaks[j + 1]]: max_k |N_ab,k| / W_k of each cell's nets (Lemma 2 on the cell)."""
     numerators, cube = numerator_nets(patch)
-    pieces = 1 << levels
+    pieces = len(breaks) - 1
     nets = np.concatenate([numerators.reshape(10, 10, 9), cube[..., None]], axis=-1)  # [j, i, c]
-    matrices = subdivision_matrices(pieces)
+    matrices = interval_matrices(breaks)
     along_u = np.einsum("sai,jic->sjac", matrices, nets)  # [u piece, j, i', c]
     out = np.empty((pieces, pieces, 3))
     for t in range(pieces):  # one v piece at a time: (S, 10, 10, 10) floats
@@ -131,6 +180,34 @@ def pyramid_cells(levels: int = SUBPATCH_LEVELS) -> int:
     return ((1 << (2 * levels + 2)) - 1) // 3
 
 
+def rounded_up(values: np.ndarray) -> np.ndarray:
+    """float32 no smaller than values * TABLE_SAFETY (next float towards +inf where needed)."""
+    values = values * TABLE_SAFETY
+    stored = values.astype(np.float32)
+    low = stored.astype(float) < values
+    stored[low] = np.nextafter(stored[low], np.float32(np.inf))
+    return stored
+
+
+def patch_table(patch: np.ndarray, levels: int = SUBPATCH_LEVELS) -> np.ndarray:
+    """(table_cells, 4) float32 of one patch: majorant_pyramid, then the graded cells' (m_uu,
+    m_uv, m_vv, 0) row by row (v, then u), rounded up likewise.  Only the graded cells are
+    subdivided: they nest in the S x S subpatches (the breakpoints include every multiple of
+    1/S), so a subpatch's majorant is taken as the max of its graded cells' (each a valid
+    majorant on its cell, and no larger than the subpatch's own hull bound: a restriction's
+    control points are convex combinations of the whole's)."""
+    breaks = graded_breaks(levels)
+    graded = cell_majorants(patch, breaks)
+    side = 1 << levels
+    owner = np.floor(breaks[:-1] * side).astype(int)  # the subpatch holding each graded cell, per axis
+    subpatches = np.zeros((side, side, 3))
+    np.maximum.at(subpatches, (owner[:, None], owner[None, :]), graded)
+    out = np.zeros((table_cells(levels), 4), np.float32)
+    out[:pyramid_cells(levels)] = majorant_pyramid(subpatches)
+    out[pyramid_cells(levels):, :3] = rounded_up(graded.reshape(-1, 3))
+    return out
+
+
 def majorant_pyramid(majorants: np.ndarray) -> np.ndarray:
     """(cells, 4) float32 of one patch: each level's (m_uu, m_uv, m_vv, 0) row by row (v, then u),
     finest first, every coarser cell the max of its four children; rounded up (float32 towards
@@ -142,34 +219,45 @@ def majorant_pyramid(majorants: np.ndarray) -> np.ndarray:
         if level.shape[0] == 1:
             break
         level = np.maximum.reduce([level[0::2, 0::2], level[1::2, 0::2], level[0::2, 1::2], level[1::2, 1::2]])
-    values = np.concatenate(rows) * TABLE_SAFETY
-    stored = values.astype(np.float32)
-    low = stored.astype(float) < values
-    stored[low] = np.nextafter(stored[low], np.float32(np.inf))
     out = np.zeros((pyramid_cells(levels), 4), np.float32)
-    out[:, :3] = stored
+    out[:, :3] = rounded_up(np.concatenate(rows))
     return out
 
 
 def scene_pyramids(patches: np.ndarray, rational: np.ndarray, levels: int = SUBPATCH_LEVELS) -> tuple[np.ndarray, np.ndarray]:
-    """((R * cells, 4) float32 pyramids of the rational patches, (P,) int32 their index (-1: none,
-    a polynomial patch, which keeps today's factors))."""
+    """((R * table_cells, 4) float32 tables (patch_table) of the rational patches, (P,) int32 their
+    index (-1: none, a polynomial patch, which keeps today's factors))."""
     index = np.full(len(patches), -1, np.int32)
     index[rational] = np.arange(int(np.count_nonzero(rational)), dtype=np.int32)
     if not rational.any():
         return np.zeros((1, 4), np.float32), index
-    tables = [majorant_pyramid(subpatch_majorants(patch, levels)) for patch in np.asarray(patches)[rational]]
+    tables = [patch_table(patch, levels) for patch in np.asarray(patches)[rational]]
     return np.concatenate(tables), index
 
 
 # --- the per-triangle bound (kernels/criteria/integral_bound.h) --------------------------------
 
 def pyramid_query(pyramid: np.ndarray, levels: int, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    """(3,) max of (m_uu, m_uv, m_vv) over the cells of one patch's pyramid that the box
-    [lo, hi] (u, v in [0, 1], widened by BOX_WIDENING) meets, at the finest level where it spans
-    at most QUERY_SPAN cells per side (float32 arithmetic as the kernel's)."""
-    side = np.float32(1 << levels)
+    """(3,) max of (m_uu, m_uv, m_vv) over the cells of one patch's table (patch_table) that the
+    box [lo, hi] (u, v in [0, 1], widened by BOX_WIDENING) meets: the graded cells if it comes
+    within 4 / S of an edge (elsewhere they are the finest subpatches) and meets fewer than
+    GRADED_SPAN of them per side, else the pyramid at the finest level where it spans at most
+    QUERY_SPAN cells per side (float32 arithmetic as the kernel's).  A pyramid alone (no graded
+    rows) reads the pyramid."""
     w = np.float32(BOX_WIDENING)
+    edge = np.float32(4) / np.float32(1 << levels)  # graded cells finer than the subpatches only there
+    near_edge = (min(np.float32(lo[0]), np.float32(lo[1])) - w < edge
+                 or max(np.float32(hi[0]), np.float32(hi[1])) + w > np.float32(1) - edge)
+    if len(pyramid) > pyramid_cells(levels) and near_edge:
+        breaks = graded_breaks(levels).astype(np.float32)
+        count = len(breaks) - 1
+        cell = lambda x: min(max(int(np.searchsorted(breaks, x, side="right")) - 1, 0), count - 1)  # noqa: E731
+        first = [cell(np.float32(lo[a]) - w) for a in range(2)]
+        last = [cell(np.float32(hi[a]) + w) for a in range(2)]
+        if last[0] - first[0] < GRADED_SPAN and last[1] - first[1] < GRADED_SPAN:
+            cells = pyramid[pyramid_cells(levels):, :3].reshape(count, count, 3)
+            return cells[first[1]:last[1] + 1, first[0]:last[0] + 1].reshape(-1, 3).max(axis=0)
+    side = np.float32(1 << levels)
     first = [int(min(max(math.floor((np.float32(lo[a]) - w) * side), 0), side - 1)) for a in range(2)]
     last = [int(min(max(math.floor((np.float32(hi[a]) + w) * side), 0), side - 1)) for a in range(2)]
     level = 0

@@ -1,6 +1,7 @@
 /* On request (Request(bound="integral")): the integral-form bound of every emitted triangle of
  * the patches marked in `check` (criteria/integral_bound.h; mirror cltess.criteria.integral
- * triangle_bound).  One work-item per triangle of the output (triangles index it, uv its
+ * triangle_bound).  `cells`: float4 rows of one patch's table (pyramid and graded cells, integral.table_cells),
+ * `breaks`: the graded cells' breakpoints (graded_count + 1).  One work-item per triangle of the output (triangles index it, uv its
  * vertices' (u, v), patch_ids its vertices' scene patch); writes bound / tolerance of the
  * triangle's patch, or 0 where the patch has no table (pyramid_of < 0) or is not checked, and
  * the max per patch to patch_worst (float bits; 0 before the launch).
@@ -12,7 +13,7 @@
 __kernel __attribute__((vec_type_hint(float4))) void integral_bound(
     __global const float4 *pyramids, __global const int *pyramid_of, __global const int *check,
     __global const float *uv, __global const int *patch_ids, __global const uint *triangles,
-    uint num_triangles, int levels, int cells, int k_first, int k_last,
+    uint num_triangles, int levels, int cells, __global const float *breaks, int graded_count, int k_first, int k_last,
     __global const float *tolerances, __global float *ratios, __global volatile int *patch_worst,
     int skip_failed)
 {
@@ -29,7 +30,8 @@ __kernel __attribute__((vec_type_hint(float4))) void integral_bound(
     float2 x0 = (float2)(uv[2 * a], uv[2 * a + 1]);
     float2 x1 = (float2)(uv[2 * b], uv[2 * b + 1]);
     float2 x2 = (float2)(uv[2 * c], uv[2 * c + 1]);
-    float ratio = integral_triangle_ratio(pyramids + (ulong)max(table, 0) * (ulong)cells, levels, x0, x1, x2,
+    float ratio = integral_triangle_ratio(pyramids + (ulong)max(table, 0) * (ulong)cells, levels,
+                                          breaks, graded_count, x0, x1, x2,
                                           tolerances[p], wanted ? k_first : 1, wanted ? k_last : 0);
     if (wanted)
         atomic_max(&patch_worst[p], as_int(ratio));

@@ -25,7 +25,8 @@ import numpy as np
 import pyopencl as cl
 import pyopencl.array as cl_array
 
-from ...criteria.integral import SUBDIVISIONS, SUBPATCH_LEVELS, TRIAL_SCALES, pyramid_cells, scene_pyramids, trial_factors
+from ...criteria.integral import (SUBDIVISIONS, SUBPATCH_LEVELS, TRIAL_SCALES, graded_breaks, scene_pyramids, table_cells,
+                                  trial_factors)
 from ...criteria.tolerance import ObjectSpace, ScreenSpace
 from ...kinds import BEZIER, FLAG_CULLED, FLAG_SATURATED
 
@@ -48,11 +49,11 @@ def integral_pyramids(tessellator, scene) -> tuple[cl_array.Array, cl_array.Arra
         return tables, index, rational
 
     def device():
-        tables, index, rational = scene.prepared(("bezier", "integral pyramids", SUBPATCH_LEVELS), host)
+        tables, index, rational = scene.prepared(("bezier", "integral tables", SUBPATCH_LEVELS), host)
         return tessellator.context, (cl_array.to_device(tessellator.queue, tables),
                                      cl_array.to_device(tessellator.queue, index), rational)
 
-    return scene.prepared(("bezier", "integral pyramids", SUBPATCH_LEVELS, id(tessellator.context)), device)[1]
+    return scene.prepared(("bezier", "integral tables", SUBPATCH_LEVELS, id(tessellator.context)), device)[1]
 
 
 def triangle_ratios(tessellator, pyramids, pyramid_of, check, uv, patch_ids, triangles, tolerances,
@@ -77,9 +78,11 @@ def triangle_ratios(tessellator, pyramids, pyramid_of, check, uv, patch_ids, tri
                         tolerances if isinstance(tolerances, cl_array.Array) else np.asarray(tolerances, np.float32))]
     ratios = cl_array.empty(queue, num, np.float32)
     worst = cl_array.to_device(queue, np.zeros(patches, np.int32))
+    breaks = cl_array.to_device(queue, graded_breaks(levels).astype(np.float32))  # dyadic: exact
     tessellator.programs.kernel("integral_bound")(
         queue, (max(64, -(-num // 64) * 64),), None, *(a.data for a in device[:6]), np.uint32(num),
-        np.int32(levels), np.int32(pyramid_cells(levels)), np.int32(subdivisions[0]), np.int32(subdivisions[-1]),
+        np.int32(levels), np.int32(table_cells(levels)), breaks.data, np.int32(len(breaks) - 1),
+        np.int32(subdivisions[0]), np.int32(subdivisions[-1]),
         device[6].data, ratios.data, worst.data, np.int32(skip_failed))
     if worst_of_patch:
         return ratios.get(), worst.get().view(np.float32)
