@@ -65,6 +65,8 @@ def _point(c: int, t: np.float32, s: np.float32) -> np.ndarray:
 #: ``(phi_m << HINT_SHIFT) | m``, m the corner of the smallest per-vertex factor phi_m (16.16,
 #: the edge factors being the larger of their ends' phi); 0: no hint.  kernels/patterns/sd2.h.
 HINT_SHIFT = 2
+#: The zone quad centre's floor factor (kernels/patterns/sd2.h SD2_CENTRE_FLOOR; _centre_mu).
+CENTRE_FLOOR = 1.0 / 64
 
 
 def sd2_hint(f) -> tuple[int, int] | None:
@@ -120,7 +122,7 @@ def _centre_mu(w: np.float32, lam: np.float32) -> np.float32:
     is a ring point, whose position the ring evaluates, and a centre on it, evaluated as an
     interior point, would differ in the last bits (a T-junction of an ulp).  Device: sd2.h."""
     one = np.float32(1.0)
-    return np.float32(np.float32(one - w) * max(np.float32(one - lam), np.float32(np.float32(0.25) * w)))
+    return np.float32(np.float32(one - w) * max(np.float32(one - lam), np.float32(np.float32(CENTRE_FLOOR) * w)))
 
 
 def _row_point(c: int, t: np.float32, z: np.float32) -> np.ndarray:

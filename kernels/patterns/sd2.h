@@ -65,6 +65,12 @@ inline int sd2_shape(int4 f, int *tip)
  * cltess/patterns/sd2.py HINT_SHIFT): (phi_m << SD2_HINT_SHIFT) | m, m the corner of the
  * smallest per-vertex factor phi_m; 0: none.  Returns 1 with *m, *phi when there is one. */
 #define SD2_HINT_SHIFT 2
+
+/* The zone quad centre's floor factor (mirror CENTRE_FLOOR; docs/sd2.md section 5): the centre
+ * keeps (1 - w) w SD2_CENTRE_FLOOR of its row off corner (i, j+1).  Small, because the centre is
+ * evaluated on the surface: sliding it along a long row (low factors) moves the mesh by up to
+ * the row's chord error. */
+#define SD2_CENTRE_FLOOR 0.015625f  /* 1 / 64 */
 inline int sd2_hint(int4 f, int *m, int *phi)
 {
     int h = abs(f.s3);  /* stage 2 stores an unused slot negated (common.h patch_factors) */
@@ -190,7 +196,7 @@ inline float3 pattern_row_point(int4 f, int j, int i)
          * off (r, i) inside the zone (mirror _centre_mu) */
         int r = j - (a - 1);
         float t = sd2_location(big, r);
-        float mu = (1.0f - w) * fmax(1.0f - lam, 0.25f * w);
+        float mu = (1.0f - w) * fmax(1.0f - lam, SD2_CENTRE_FLOOR * w);
         float keep = 1.0f - mu;
         float right = keep * sd2_fan_z(t, sd2_location(base, i), w, lam);
         float left = mu * sd2_fan_z(t, sd2_location(base, i - 1), w, lam);
