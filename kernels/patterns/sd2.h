@@ -65,12 +65,6 @@ inline int sd2_shape(int4 f, int *tip)
  * cltess/patterns/sd2.py HINT_SHIFT): (phi_m << SD2_HINT_SHIFT) | m, m the corner of the
  * smallest per-vertex factor phi_m; 0: none.  Returns 1 with *m, *phi when there is one. */
 #define SD2_HINT_SHIFT 2
-
-/* The zone quad centre's floor factor (mirror CENTRE_FLOOR; docs/sd2.md section 5): the centre
- * keeps (1 - w) w SD2_CENTRE_FLOOR of its row off corner (i, j+1).  Small, because the centre is
- * evaluated on the surface: sliding it along a long row (low factors) moves the mesh by up to
- * the row's chord error. */
-#define SD2_CENTRE_FLOOR 0.015625f  /* 1 / 64 */
 inline int sd2_hint(int4 f, int *m, int *phi)
 {
     int h = abs(f.s3);  /* stage 2 stores an unused slot negated (common.h patch_factors) */
@@ -78,6 +72,13 @@ inline int sd2_hint(int4 f, int *m, int *phi)
     *phi = h >> SD2_HINT_SHIFT;
     return h > 0 && *m < 3;
 }
+
+/* The zone quad centre's floor factor (mirror CENTRE_FLOOR, _centre_mu; docs/sd2.md section 5):
+ * the centre keeps (1 - w) w SD2_CENTRE_FLOOR of its row off corner (i, j+1), a ring point in the
+ * last column.  Small, because the centre is evaluated on the surface: sliding it along a long
+ * row (low factors) moves the mesh by up to the row's chord error (1/4 moved a corner leaving the
+ * plateau of 1 at 2.3 errors per factor unit, 1/64 at 1.0). */
+#define SD2_CENTRE_FLOOR 0.015625f  /* 1 / 64 */
 
 /* The tie zone of the fan with tip c (mirror sd2_morph): 1 when in it, with *w the radial
  * pattern's weight (F - G) / 1.0 and *lam the weight of the tie with partner c+1,
