@@ -27,6 +27,9 @@ bench/sd2.py's (the paper's sphere, and its violin case and cow sizes).  Columns
   triple   steps whose worst patch is near a triple tie (its three corners' factors within one
            factor unit of each other, in either frame: docs/sd2.md section 5, "Triple ties")
   worst other  the worst over the patches not near a triple tie
+  no blend the worst over the patches whose tie zone does not blend two tie configurations
+           (0 < lam < 1, docs/sd2.md section 5) in either frame: what is left without the
+           triple-tie blends, which this fan cannot make proportional (docs/sd2.md, "Third pass")
 """
 from __future__ import annotations
 
@@ -249,6 +252,18 @@ def near_triple_tie(records: np.ndarray) -> np.ndarray:
     return (f[:, 0] > 0) & (f.max(axis=1) - smallest < FIXED_ONE)
 
 
+def blending(records: np.ndarray) -> np.ndarray:
+    """(P,) bool: the patch's fan is in the tie zone with 0 < lam < 1 (a blend of two tie
+    configurations; cltess/patterns/sd2.py sd2_morph)."""
+    from cltess.patterns.sd2 import _Layout
+    out = np.zeros(len(records), bool)
+    for k, record in enumerate(records):
+        if record[0] > 0:
+            layout = _Layout(record)
+            out[k] = bool(layout.zone) and layout.lam < 1
+    return out
+
+
 def frame_options(level_function: str, camera, low: float, high: float, band: float, depth_range, pixels: float):
     if level_function == "bound":  # the error bound at a screen-space tolerance of this frame's camera
         return dict(pixels=pixels, pattern="sd2", level_function="bound", max_factor=64)
@@ -277,6 +292,8 @@ def measure(tessellator, scene, sweep: float, steps: int, low: float, high: floa
         near = [near_triple_tie(ra) | near_triple_tie(rb) for ra, rb in zip(records, records[1:])]
         others = np.array([np.where(n, 0.0, d).max() for (d, _), n in zip(measured, near)])
         triple = sum(bool(n[np.argmax(d)]) and d.max() > 0 for (d, _), n in zip(measured, near))
+        blends = [blending(ra) | blending(rb) for ra, rb in zip(records, records[1:])]
+        no_blend = max(float(np.where(b, 0.0, d).max()) for (d, _), b in zip(measured, blends))
         distances = [d for d, _ in measured]
         step_worst = np.array([d.max() for d in distances])
         median = float(np.median(step_worst))
@@ -285,7 +302,7 @@ def measure(tessellator, scene, sweep: float, steps: int, low: float, high: floa
         out[count] = {"step_deg": sweep / count, "worst": float(step_worst.max()), "median": median,
                       "jumps": int(np.count_nonzero(step_worst > 4 * median)), "tips": int(tips), "steps": count,
                       "relaid": int(relaid), "triangles": int(np.mean([f.num_triangles for f in frames])),
-                      "triple": int(triple), "worst_other": float(others.max())}
+                      "triple": int(triple), "worst_other": float(others.max()), "no_blend": no_blend}
     return out
 
 
@@ -316,12 +333,15 @@ def main(argv=None) -> int:
     print(f"{args.mesh} ({scene.num_triangles} faces), {what}, {args.sweep:g} degree orbit, {args.measure} "
           f"distance, device {tessellator.device.name.strip()}")
     print(f"{'step deg':>9} {'worst':>9} {'median':>9} {'jumps':>6} {'tips':>5} {'relaid':>7} {'triangles':>10}"
-          f" {'triple':>6} {'worst other':>11}")
+          f" {'triple':>6} {'worst other':>11} {'no blend':>9}")
     for row in result.values():
         print(f"{row['step_deg']:9.3f} {row['worst']:9.5f} {row['median']:9.5f} {row['jumps']:6d} {row['tips']:5d}"
-              f" {row['relaid']:7d} {row['triangles']:10d} {row['triple']:6d} {row['worst_other']:11.5f}")
-    fine, coarse = result[2 * args.steps]["worst"], result[args.steps]["worst"]
-    print(f"worst at half the step / worst at the step: {fine / coarse:.3f}")
+              f" {row['relaid']:7d} {row['triangles']:10d} {row['triple']:6d} {row['worst_other']:11.5f}"
+              f" {row['no_blend']:9.5f}")
+    fine, coarse = result[2 * args.steps], result[args.steps]
+    print(f"worst at half the step / worst at the step: {fine['worst'] / coarse['worst']:.3f}")
+    if coarse["no_blend"] > 0:
+        print(f"the same without tie-configuration blends: {fine['no_blend'] / coarse['no_blend']:.3f}")
     if args.json:
         Path(args.json).write_text(json.dumps({"mesh": args.mesh, "level_function": args.level_function,
                                                "measure": args.measure, "rows": list(result.values())}, indent=1))

@@ -65,6 +65,8 @@ def _point(c: int, t: np.float32, s: np.float32) -> np.ndarray:
 #: ``(phi_m << HINT_SHIFT) | m``, m the corner of the smallest per-vertex factor phi_m (16.16,
 #: the edge factors being the larger of their ends' phi); 0: no hint.  kernels/patterns/sd2.h.
 HINT_SHIFT = 2
+#: The zone quad centre's floor factor (kernels/patterns/sd2.h SD2_CENTRE_FLOOR; _centre_mu).
+CENTRE_FLOOR = 1.0 / 64
 
 
 def sd2_hint(f) -> tuple[int, int] | None:
@@ -114,13 +116,18 @@ def _fan_z(t: np.float32, s: np.float32, w: np.float32, lam: np.float32) -> np.f
 
 def _centre_mu(w: np.float32, lam: np.float32) -> np.float32:
     """How far a zone quad's centre has slid from its corner (i, j+1) towards (i, j):
-    ``(1 - w) max(1 - lam, w / 4)``.  (1 - w)(1 - lam) is the slide of docs/sd2.md section 5;
-    the floor w (1 - w) / 4, zero at the zone's two ends (w = 1: the radial pattern, w = 0: a
-    tie), keeps the centre off (i, j+1) inside the zone when lam = 1: the last column's (i, j+1)
-    is a ring point, whose position the ring evaluates, and a centre on it, evaluated as an
-    interior point, would differ in the last bits (a T-junction of an ulp).  Device: sd2.h."""
+    ``(1 - w) max(1 - lam, CENTRE_FLOOR w)``.  (1 - w)(1 - lam) is the slide of docs/sd2.md
+    section 5; the floor w (1 - w) / 64, zero at the zone's two ends (w = 1: the radial pattern,
+    w = 0: a tie), keeps the centre off (i, j+1) inside the zone when lam = 1: the last column's
+    (i, j+1) is a ring point, whose position the ring evaluates, and a centre on it, evaluated as
+    an interior point, would differ in the last bits (a T-junction of an ulp).  Small: the centre
+    is evaluated on the surface, and at low factors its row spans the triangle, so each unit of
+    slide moves the mesh by up to that row's chord error (the first floor, w (1 - w) / 4, moved a
+    corner's departure from the plateau of 1 at 2.3 errors per factor unit; / 64: 1.0, uniform
+    refinement 0.96).  At w = 1/65536 it is still 2.4e-7 of the row, 4 float32 ulps of 1.
+    Device: sd2.h."""
     one = np.float32(1.0)
-    return np.float32(np.float32(one - w) * max(np.float32(one - lam), np.float32(np.float32(0.25) * w)))
+    return np.float32(np.float32(one - w) * max(np.float32(one - lam), np.float32(np.float32(CENTRE_FLOOR) * w)))
 
 
 def _row_point(c: int, t: np.float32, z: np.float32) -> np.ndarray:

@@ -73,6 +73,13 @@ inline int sd2_hint(int4 f, int *m, int *phi)
     return h > 0 && *m < 3;
 }
 
+/* The zone quad centre's floor factor (mirror CENTRE_FLOOR, _centre_mu; docs/sd2.md section 5):
+ * the centre keeps (1 - w) w SD2_CENTRE_FLOOR of its row off corner (i, j+1), a ring point in the
+ * last column.  Small, because the centre is evaluated on the surface: sliding it along a long
+ * row (low factors) moves the mesh by up to the row's chord error (1/4 moved a corner leaving the
+ * plateau of 1 at 2.3 errors per factor unit, 1/64 at 1.0). */
+#define SD2_CENTRE_FLOOR 0.015625f  /* 1 / 64 */
+
 /* The tie zone of the fan with tip c (mirror sd2_morph): 1 when in it, with *w the radial
  * pattern's weight (F - G) / 1.0 and *lam the weight of the tie with partner c+1,
  * min(e2 / e1, 1), e_k = F - phi_k (1 when the base corners tie with each other: a plateau left
@@ -190,7 +197,7 @@ inline float3 pattern_row_point(int4 f, int j, int i)
          * off (r, i) inside the zone (mirror _centre_mu) */
         int r = j - (a - 1);
         float t = sd2_location(big, r);
-        float mu = (1.0f - w) * fmax(1.0f - lam, 0.25f * w);
+        float mu = (1.0f - w) * fmax(1.0f - lam, SD2_CENTRE_FLOOR * w);
         float keep = 1.0f - mu;
         float right = keep * sd2_fan_z(t, sd2_location(base, i), w, lam);
         float left = mu * sd2_fan_z(t, sd2_location(base, i - 1), w, lam);
