@@ -34,6 +34,12 @@ from .io.ply import PlyWriter
 
 COPIES_IN_FLIGHT = 3  # device buffers, host copy, writer records
 STREAMING_WRITERS = {".ply": PlyWriter, ".obj": ObjWriter, ".npz": NpzWriter}
+#: Output bytes per batch when a large .ply or .obj is streamed, whatever the budget allows:
+#: two sets of batch buffers are reused throughout, so the process touches 2 x 32 MB of fresh
+#: memory instead of the whole output (556 MB first touched took 0.82 s on the 2-vCPU VM,
+#: touched again 0.04 s), and the device computes batch k+1 while batch k is written.
+#: bench/RESULTS.md, "Issue 15: the 30k-patch PLY (session 4)".
+STREAM_BATCH_BYTES = 32 << 20
 
 
 @dataclass
@@ -81,6 +87,11 @@ def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = 
         ranges = plan.batch_ranges(max(budget // COPIES_IN_FLIGHT, 1))
     except OutputTooLarge as error:
         raise OutputTooLarge(f"{error} (a batch may take a third of the memory cap, {budget} bytes)") from None
+    if not weld and extension in (".ply", ".obj") and budget // COPIES_IN_FLIGHT > STREAM_BATCH_BYTES:
+        try:  # smaller batches than the budget allows: for speed (unless a patch alone is larger)
+            ranges = plan.batch_ranges(STREAM_BATCH_BYTES)
+        except OutputTooLarge:
+            pass
     if weld or extension not in STREAMING_WRITERS or (extension == ".npz" and len(ranges) == 1):
         if len(ranges) > 1:
             why = "a welded mesh is built in memory" if weld else f"{extension} cannot be streamed"
