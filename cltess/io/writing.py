@@ -89,8 +89,9 @@ def _face_array(triangles, num_vertices: int) -> np.ndarray:
     triangles = np.asarray(triangles)
     if triangles.ndim != 2 or triangles.shape[1] != 3:
         raise ValueError(f"triangles must have shape (n, 3), got {triangles.shape}")
-    if len(triangles):
-        low, high = int(triangles.min()), int(triangles.max())
+    if len(triangles):  # unsigned indices (the device's): no pass for the minimum
+        low = 0 if triangles.dtype.kind == "u" else int(triangles.min())
+        high = int(triangles.max())
         if low < 0 or high >= num_vertices:
             raise ValueError(f"triangle indices span [{low}, {high}], outside [0, {num_vertices})")
     return np.ascontiguousarray(triangles, dtype=np.uint32)
