@@ -62,7 +62,7 @@ def default_budget(device: cl.Device) -> int:
 
 def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = None,
                        weld: bool = False, uv: str = "drop", on_plan=None, on_batch=None, progress=None,
-                       verify: bool = False, **options) -> StreamResult:
+                       verify: bool = False, batch_bytes: int | None = None, **options) -> StreamResult:
     """Tessellate ``scene`` into ``path`` (.ply, .obj, .stl, .glb or .npz) within ``max_memory_bytes``.
 
     options: eps / pixels / max_factor / forward_differencing, as for ``Tessellator.tessellate``.
@@ -75,6 +75,8 @@ def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = 
     progress(stage, done, total): called as batches are written.
     verify: measure the error of every batch on the device (``Tessellator.verify``); the stats
     (and a .npz file's stats_json) carry "verify_ratio" and where it occurs.
+    batch_bytes: output per batch of a streamed .ply or .obj at most (None: STREAM_BATCH_BYTES;
+    0: as much as the budget allows, one pass if the output fits); the file is the same.
     """
     path = Path(path)
     extension = check_extension(path)
@@ -87,9 +89,10 @@ def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = 
         ranges = plan.batch_ranges(max(budget // COPIES_IN_FLIGHT, 1))
     except OutputTooLarge as error:
         raise OutputTooLarge(f"{error} (a batch may take a third of the memory cap, {budget} bytes)") from None
-    if not weld and extension in (".ply", ".obj") and budget // COPIES_IN_FLIGHT > STREAM_BATCH_BYTES:
+    batch_bytes = STREAM_BATCH_BYTES if batch_bytes is None else batch_bytes
+    if not weld and extension in (".ply", ".obj") and 0 < batch_bytes < budget // COPIES_IN_FLIGHT:
         try:  # smaller batches than the budget allows: for speed (unless a patch alone is larger)
-            ranges = plan.batch_ranges(STREAM_BATCH_BYTES)
+            ranges = plan.batch_ranges(batch_bytes)
         except OutputTooLarge:
             pass
     if weld or extension not in STREAMING_WRITERS or (extension == ".npz" and len(ranges) == 1):

@@ -423,9 +423,27 @@ def test_python_dash_m_runs(tmp_path):
     assert result.stdout.startswith("cltess ")
 
 
-def test_console_script_points_at_main():
+def test_console_script_points_at_run():
     import tomllib
 
     scripts = tomllib.loads((REPO / "pyproject.toml").read_text())["project"]["scripts"]
     module, function = scripts["cltess"].split(":")
-    assert (module, function) == ("cltess.cli", "main") and cli.main is main
+    assert (module, function) == ("cltess.cli", "run") and cli.main is main
+
+
+@pytest.mark.parametrize("quick", ["1", "0"])
+def test_quick_exit_keeps_the_output_the_summary_and_the_code(tmp_path, quick):
+    """``python -m cltess`` (run(): os._exit after tessellate) prints the whole summary, leaves
+    the complete file and no temporary one, and exits with main's code, as without it."""
+    import subprocess
+
+    env = dict(os.environ, CLTESS_QUICK_EXIT=quick)
+    output = tmp_path / "teapot.ply"
+    done = subprocess.run([sys.executable, "-m", "cltess", "tessellate", str(REPO / "scenes" / "teapot.bez"),
+                           "--eps", "0.01", "--no-weld", "-o", str(output)], capture_output=True, text=True, env=env)
+    assert done.returncode == 0, done.stderr
+    assert "triangles" in done.stdout and str(output) in done.stdout
+    assert [p.name for p in tmp_path.iterdir()] == ["teapot.ply"] and output.stat().st_size > 1000
+    bad = subprocess.run([sys.executable, "-m", "cltess", "tessellate", str(tmp_path / "missing.bez"), "--eps",
+                          "0.01", "-o", str(tmp_path / "x.ply")], capture_output=True, text=True, env=env)
+    assert bad.returncode == 2 and "cltess: error:" in bad.stderr and "missing.bez" in bad.stderr

@@ -32,8 +32,10 @@ import numpy as np
 #: Offsets and lengths of direct writes are multiples of this (4 KiB covers 512-byte and 4K
 #: sector disks; buffers are page-aligned mmaps).
 BLOCK = 4096
-#: Bytes staged per region before a write (plus one block for the carried partial block).
-STAGING_BYTES = 8 << 20
+#: Bytes staged per region before a write (plus one block for the carried partial block); a
+#: region has two such buffers (one built while the other is written), a PLY two regions of
+#: size: 16 MB in all, within the stated overhead of a streamed run (tests/test_stream.py).
+STAGING_BYTES = 4 << 20
 
 
 def _set_direct(fd: int) -> bool:
