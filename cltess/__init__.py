@@ -4,7 +4,14 @@
 >>> tess = Tessellator().tessellate(load_scene("scenes/teapot.bez"), eps=1e-3)
 >>> export(tess, "teapot.ply")
 """
+from importlib import metadata as _metadata
+
 from .runtimes import register_pip_runtimes
+
+try:
+    __version__ = _metadata.version("cltess")
+except _metadata.PackageNotFoundError:  # run from a source tree that was never installed
+    __version__ = "0+unknown"
 
 # Before anything lists OpenCL platforms: let the ICD loader see pip-installed CPU runtimes.
 register_pip_runtimes()
@@ -16,13 +23,6 @@ from .tessellation import Tessellation  # noqa: E402
 
 
 def __getattr__(name):
-    if name == "__version__":  # lazy: importlib.metadata takes 40-50 ms to import
-        from importlib import metadata
-
-        try:
-            return metadata.version("cltess")
-        except metadata.PackageNotFoundError:  # run from a source tree that was never installed
-            return "0+unknown"
     # Lazy: importing cltess must not need an OpenCL platform.
     if name == "Tessellator":
         from .backends.opencl import Tessellator

@@ -18,6 +18,7 @@ from __future__ import annotations
 import hashlib
 import os
 import sys
+from importlib import metadata
 from pathlib import Path
 
 __all__ = ["ICD_ENV_VAR", "OPT_OUT_ENV_VAR", "SYSTEM_ICD_DIR", "cache_dir", "pip_runtime_libraries", "register_pip_runtimes"]
@@ -41,47 +42,20 @@ def cache_dir() -> Path:
 
 
 def pip_runtime_libraries() -> dict[str, Path]:
-    """The ICD library of each pip-installed runtime that is present: {distribution: path}.
-    As ``importlib.metadata`` finds it (the first ``.dist-info`` on ``sys.path``, the library
-    listed in its RECORD), read here directly: importing importlib.metadata took 40-50 ms of
-    every command's start (bench/RESULTS.md, "Issue 15: the 30k-patch PLY")."""
+    """The ICD library of each pip-installed runtime that is present: {distribution: path}."""
     found = {}
     for distribution, library in PIP_RUNTIMES.items():
-        for folder, record in _records(distribution):
-            path = _listed(folder, record, library)
-            if path is not None:
-                found[distribution] = path
-            break  # the first distribution found is the one installed (as importlib.metadata)
-    return found
-
-
-def _records(distribution: str):
-    """(folder, RECORD path) of each ``.dist-info`` of ``distribution`` on sys.path, in order."""
-    prefix = distribution.replace("-", "_").lower() + "-"
-    for entry in sys.path:
-        folder = Path(entry or ".")
         try:
-            names = os.listdir(folder)
-        except OSError:
+            files = metadata.distribution(distribution).files or ()
+        except metadata.PackageNotFoundError:
             continue
-        for name in sorted(names):
-            if name.lower().startswith(prefix) and name.endswith(".dist-info"):
-                yield folder, folder / name / "RECORD"
-
-
-def _listed(folder: Path, record: Path, library: str) -> Path | None:
-    """The existing file named ``library`` that RECORD lists (paths relative to ``folder``)."""
-    try:
-        lines = record.read_text(encoding="utf-8").splitlines()
-    except (OSError, UnicodeDecodeError):
-        return None
-    for line in lines:
-        name = line.rsplit(",", 2)[0].strip('"')  # path,hash,size (no commas in these paths)
-        if name.rsplit("/", 1)[-1] == library:
-            path = (folder / name).resolve()
-            if path.is_file():
-                return path
-    return None
+        for file in files:
+            if file.name == library:
+                path = Path(file.locate()).resolve()
+                if path.is_file():
+                    found[distribution] = path
+                    break
+    return found
 
 
 def _icd_lines(source: str | None) -> list[str]:
