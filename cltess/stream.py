@@ -35,11 +35,13 @@ from .io.ply import PlyWriter
 COPIES_IN_FLIGHT = 3  # device buffers, host copy, writer records
 STREAMING_WRITERS = {".ply": PlyWriter, ".obj": ObjWriter, ".npz": NpzWriter}
 #: Output bytes per batch when a large .ply or .obj is streamed, whatever the budget allows:
-#: two sets of batch buffers are reused throughout, so the process touches 2 x 32 MB of fresh
-#: memory instead of the whole output (556 MB first touched took 0.82 s on the 2-vCPU VM,
-#: touched again 0.04 s), and the device computes batch k+1 while batch k is written.
-#: bench/RESULTS.md, "Issue 15: the 30k-patch PLY (session 4)".
-STREAM_BATCH_BYTES = 32 << 20
+#: two sets of batch buffers are reused throughout, so the process touches 2 x 8 MB of fresh
+#: output memory instead of the whole output (556 MB first touched took 0.5-1.4 s on the 2-vCPU
+#: VM, touched again 0.03-0.07 s), a batch is still in the CPU's cache when the host reads it,
+#: and the device computes batch k+1 while batch k is written.  The 30k-patch PLY, median wall
+#: of 5 (load 11): 8 MB 2.65 s, 4 MB 2.91, 32 MB 3.35, one pass 4.6 (CPU the same within
+#: 0.1 s, one pass 0.2-0.3 s more).  bench/RESULTS.md, "Issue 15: the 30k-patch PLY (session 4)".
+STREAM_BATCH_BYTES = 8 << 20
 
 
 @dataclass
