@@ -21,10 +21,19 @@ less than the wall clock.
 
 Then the same steps timed one by one in this process (warm kernels), to show where the time
 goes.
+
+Each tree writes its own PLY (``out.ply``, ``out-baseline.ply``): a buffered writer that
+replaces a file the other tree wrote through the page cache reuses the 556 MB of pages that
+file's removal has just freed, which on this VM (free page reporting: freed memory goes back to
+the host about two seconds later, and is faulted in again at ~1.5 ms per MB) made the baseline
+look up to 2x faster than a run on its own.  ``--spacing S`` waits S seconds before every run,
+so that no run starts on memory the previous one freed (a user's single run); the default 0
+is runs back to back.  The two PLYs' MD5 are compared at the end (bitwise the same output).
 """
 from __future__ import annotations
 
 import argparse
+import hashlib
 import math
 import os
 import resource
@@ -55,11 +64,13 @@ def write_scene(path: Path, copies: int = 960) -> None:
 
 
 CPU_SECONDS: list = []  # (user + system) CPU seconds of each child run, in run order
+LOADS: list = []  # the 1-minute load average as each child run started
 
 
 def run_child(command: list[str], env: dict) -> float:
     """Wall seconds of a child process; its CPU seconds (user + system, all its threads) are
     appended to CPU_SECONDS."""
+    LOADS.append(os.getloadavg()[0])
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     started = time.perf_counter()
     done = subprocess.run(command, env=env, capture_output=True, text=True)
@@ -71,8 +82,20 @@ def run_child(command: list[str], env: dict) -> float:
     return wall
 
 
+SPACING = [0.0]  # seconds to wait before each child (--spacing)
+
+
 def run_cli(args: list[str], env: dict) -> float:
+    time.sleep(SPACING[0])
     return run_child([sys.executable, "-m", "cltess", "tessellate", *args], env)
+
+
+def md5(path: Path) -> str:
+    digest = hashlib.md5()
+    with open(path, "rb") as handle:
+        for block in iter(lambda: handle.read(1 << 24), b""):
+            digest.update(block)
+    return digest.hexdigest()
 
 
 #: The peer of the PLY write: the same number of bytes from one NumPy array, ``tofile`` into
@@ -90,6 +113,7 @@ os.replace(sys.argv[2] + ".tmp", sys.argv[2])
 
 
 def run_peer(size: int, path: Path, env: dict) -> float:
+    time.sleep(SPACING[0])
     return run_child([sys.executable, "-c", PEER, str(size), str(path)], env)
 
 
@@ -155,18 +179,26 @@ def main() -> int:
     parser.add_argument("--baseline", metavar="SOURCE_TREE",
                         help="also run the CLI of another checkout (PYTHONPATH=SOURCE_TREE), its runs "
                              "interleaved with these, e.g. the main branch before issue 15")
+    parser.add_argument("--spacing", type=float, default=0.0, metavar="S",
+                        help="seconds to wait before every child run (memory freed by the last run is "
+                             "then no longer reused: a single run's conditions); default 0")
+    parser.add_argument("--states", default="cold,warm", help="which of cold,warm to run (default both)")
     args = parser.parse_args()
+    SPACING[0] = args.spacing
     with tempfile.TemporaryDirectory(dir=args.folder or ".") as folder:
         folder = Path(folder)
         scene = folder / "teapots30k.bpt"
         write_scene(scene)
-        out = folder / "out.ply"
-        base = ["--eps", str(args.eps), "--no-weld", "-q", "-o", str(out)] + (["--device", args.device] if args.device else [])
-        print(f"{scene.name}: {scene.stat().st_size / 1e6:.1f} MB; load average {os.getloadavg()}")
-        rows, cpu = {}, {}
+        out, base_out = folder / "out.ply", folder / "out-baseline.ply"
+        common = ["--eps", str(args.eps), "--no-weld", "-q"] + (["--device", args.device] if args.device else [])
+        base = common + ["-o", str(out)]
+        baseline_args = common + ["-o", str(base_out)]
+        print(f"{scene.name}: {scene.stat().st_size / 1e6:.1f} MB; load average {os.getloadavg()}; "
+              f"spacing {args.spacing:g} s")
+        rows, cpu, loads = {}, {}, {}
         peer = folder / "peer.bin"
         for orient in ("--orient", "--no-orient"):
-            for state in ("cold", "warm"):
+            for state in [state for state in ("cold", "warm") if state in args.states.split(",")]:
                 walls, baseline, peers, imports = [], [], [], []
                 for _ in range(args.repeat):
                     cache = folder / f"cache-{orient}-{len(walls)}"  # cold: a fresh cache each run
@@ -175,20 +207,24 @@ def main() -> int:
                         run_cli([str(scene), orient, *base], env)  # fills the warm cache
                     walls.append(run_cli([str(scene), orient, *base], env))
                     cpu.setdefault((orient, state), []).append(CPU_SECONDS[-1])
+                    loads.setdefault((orient, state), []).append(LOADS[-1])
                     if args.baseline:  # its own caches: a fresh one (cold), its warm one (warm)
                         base_cache = folder / (f"cache-baseline-{orient}-{len(walls)}" if state == "cold"
                                                else "cache-baseline")
                         base_env = dict(env, PYTHONPATH=str(Path(args.baseline).resolve()),
                                         CLTESS_SCENE_CACHE=str(base_cache))
                         if state == "warm" and not baseline:
-                            run_cli([str(scene), orient, *base], base_env)  # fills its warm cache
-                        baseline.append(run_cli([str(scene), orient, *base], base_env))
+                            run_cli([str(scene), orient, *baseline_args], base_env)  # fills its warm cache
+                        baseline.append(run_cli([str(scene), orient, *baseline_args], base_env))
                         cpu.setdefault((orient, f"{state}, baseline"), []).append(CPU_SECONDS[-1])
+                        loads.setdefault((orient, f"{state}, baseline"), []).append(LOADS[-1])
                     if orient == "--orient" and state == "warm":  # the peers, in the same loop
                         peers.append(run_peer(out.stat().st_size, peer, env))
                         cpu.setdefault(("peer", "write"), []).append(CPU_SECONDS[-1])
+                        loads.setdefault(("peer", "write"), []).append(LOADS[-1])
                         imports.append(run_imports(env))
                         cpu.setdefault(("peer", "imports"), []).append(CPU_SECONDS[-1])
+                        loads.setdefault(("peer", "imports"), []).append(LOADS[-1])
                 rows[(orient, state)] = walls
                 if baseline:
                     rows[(orient, f"{state}, baseline")] = baseline
@@ -196,15 +232,20 @@ def main() -> int:
                     rows[("peer", "write")] = peers
                     rows[("peer", "imports")] = imports
         size = out.stat().st_size
+        if args.baseline:
+            same = md5(out) == md5(base_out)
+            print(f"PLY MD5 {md5(out)}; the baseline's {'the same' if same else 'DIFFERENT: ' + md5(base_out)}")
         print(f"PLY {size / 1e6:.0f} MB, eps {args.eps}; wall seconds, median [min-max] of {args.repeat}; "
               f"CPU seconds (user + system) of the same runs, median [min]:")
         for (orient, state), walls in rows.items():
             spent = cpu[(orient, state)]
             label = {"write": "tofile + fsync + rename of the PLY's bytes", "imports": "python + the CLI's imports"}.get(
                 state, state) if orient == "peer" else state
+            load = loads[(orient, state)]
             print(f"  {orient:12} {label:44}: {statistics.median(walls):.2f} [{min(walls):.2f}-{max(walls):.2f}]"
-                  f"   CPU {statistics.median(spent):.2f} [{min(spent):.2f}]")
+                  f"   CPU {statistics.median(spent):.2f} [{min(spent):.2f}]   load {min(load):.1f}-{max(load):.1f}")
         os.environ["CLTESS_SCENE_CACHE"] = str(folder / "cache")
+        SPACING[0] = 0.0
         steps(scene, out, args.eps, args.device)  # warm-up
         for name, value in steps(scene, out, args.eps, args.device).items():
             print(f"  step: {name}: {value:.2f}")

@@ -567,12 +567,16 @@ def cmd_tessellate(args) -> int:
     if args.uv == "seam" and output.suffix.lower() not in (".ply", ".obj", ".npz"):
         raise UsageError(f"{output}: --uv seam can be written to .ply, .obj or .npz only")
     preview = _check_preview(args.preview, args.scene) if args.preview else None
-    scene, orientation, eps_text = _prepare_scene(args)
-    device = pick_device(args.device)
-
     from cltess.pipeline import Tessellator  # lazy: builds OpenCL programs
 
-    tessellator = Tessellator(device=device)
+    opening = _in_background(lambda: Tessellator(device=pick_device(args.device)))
+    try:  # the scene loads while the OpenCL runtime starts (C code: the GIL is free)
+        scene, orientation, eps_text = _prepare_scene(args)
+    except BaseException:
+        opening.join()  # nothing left running; the scene's error is the one reported
+        raise
+    tessellator = opening.result()
+    device = tessellator.device
     mesh_options = {"sharp_edges": args.sharp_edges} if scene.meshes else {}
     mesh_options.update(_level_options(args, scene))
     def before_writing(plan):
@@ -637,6 +641,32 @@ def cmd_tessellate(args) -> int:
         print(format_summary(result.stats, result.stage_ms, scene=args.scene, device=device.name.strip(),
                              tolerance=eps_text, output=output if preview is None else f"{output}, {preview}"))
     return EXIT_OK
+
+
+class _in_background:
+    """``make()`` on a thread started now; ``result()`` joins it and returns its value or
+    raises its exception.  For the OpenCL start-up (platforms, context: 0.1-0.2 s of C code
+    that releases the GIL), overlapped with the scene's loading."""
+
+    def __init__(self, make):
+        self._value, self._error = None, None
+        self._thread = threading.Thread(target=self._run, args=(make,), name="cltess-opencl", daemon=True)
+        self._thread.start()
+
+    def _run(self, make):
+        try:
+            self._value = make()
+        except BaseException as error:  # handed to result()
+            self._error = error
+
+    def join(self) -> None:
+        self._thread.join()
+
+    def result(self):
+        self._thread.join()
+        if self._error is not None:
+            raise self._error
+        return self._value
 
 
 def cmd_tessellate_frames(args) -> int:
@@ -909,6 +939,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         with _terminate_like_ctrl_c():
             args = build_parser().parse_args(argv)
+            _RAN[:] = [args.command]
             if not args.verbose:  # pyopencl's "non-empty compiler output" means nothing to a user
                 warnings.filterwarnings("ignore", category=cl.CompilerWarning)
             return _COMMANDS[args.command](args)
@@ -939,6 +970,29 @@ def main(argv: list[str] | None = None) -> int:
         return _fail(message, EXIT_USAGE)
     except RuntimeError as error:  # e.g. an OpenCL program that failed to build
         return _fail(error, EXIT_DEVICE)
+
+
+#: The command main() ran last (for ``run``).
+_RAN: list = []
+#: Commands after which the process exits at once (``os._exit``): their files are complete
+#: (fsync'd, renamed) when main returns, and what Python's shutdown would still do (collect
+#: every object, release the OpenCL runtime's buffers, programs and threads) took 0.1-0.3 s
+#: of the 30k-patch PLY's wall time (bench/RESULTS.md, "Issue 15: the 30k-patch PLY").  Not
+#: ``batch``: its Dask cluster is closed by handlers at exit.
+QUICK_EXIT_COMMANDS = ("tessellate", "render", "devices")
+
+
+def run() -> None:
+    """The ``cltess`` console command and ``python -m cltess``: ``main()``, then the exit."""
+    code = main()
+    if _RAN and _RAN[0] in QUICK_EXIT_COMMANDS and os.environ.get("CLTESS_QUICK_EXIT", "1") != "0":
+        try:
+            sys.stdout.flush()
+            sys.stderr.flush()
+        except OSError:  # e.g. a closed pipe: let Python's own exit report it
+            sys.exit(code)
+        os._exit(code)
+    sys.exit(code)
 
 
 class Terminated(BaseException):

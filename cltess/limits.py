@@ -148,7 +148,8 @@ def largest_coordinate(scene) -> float:
     Cartesian control points (the surface lies in their hull, weights > 0) and mesh vertices."""
     extents = [0.0]
     if len(scene.patches):
-        extents.append(float(np.abs(scene.patches[..., :3] / scene.patches[..., 3:]).max()))
+        cartesian = scene.patches[..., :3] / scene.patches[..., 3:]  # max |x| without a second array
+        extents.append(float(np.maximum(cartesian.max(), -cartesian.min())))
     extents += [float(np.abs(mesh.vertices).max()) for mesh in scene.meshes]
     return max(extents)
 

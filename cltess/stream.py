@@ -9,11 +9,13 @@ too (``io.npz.NpzWriter``: its arrays spooled to temporary files, then zipped): 
 arrays as the single pass, a strip pattern's strips (SD-2, ESC) included; PLY and OBJ write
 the triangles, which are the strips expanded.
 
-Memory: batches are sized to a third of the budget.  Two batches' output buffers are alive at
+Memory: batches are sized to a third of the budget, and a per-patch .ply's to at most
+``STREAM_BATCH_BYTES`` (8 MB: for speed, measured).  Two batches' output buffers are alive at
 once (``_overlapped``: the device computes batch k+1 while the host writes batch k), and on a
 GPU their two page-locked host copies; on a CPU device the buffers are mapped, so the host
-arrays are the device buffers themselves.  The writer builds its records in 10 MB chunks.
-Between them at most 2 of the 3 thirds of the budget, plus the chunks.
+arrays are the device buffers themselves.  The PLY writer builds its records in four 4 MB
+staging buffers (``io.direct``), the OBJ writer in chunks.  Between them at most 2 of the 3
+thirds of the budget, plus the staging.
 
 on_batch gets each batch as it is written: its arrays are views of buffers that batch k+2
 reuses, so copy what must outlive the call.
@@ -34,6 +36,15 @@ from .io.ply import PlyWriter
 
 COPIES_IN_FLIGHT = 3  # device buffers, host copy, writer records
 STREAMING_WRITERS = {".ply": PlyWriter, ".obj": ObjWriter, ".npz": NpzWriter}
+#: Output bytes per batch when a large .ply is streamed, whatever the budget allows (not .obj:
+#: its faces before the last vertices go to a spool, and its text formatting is the cost):
+#: two sets of batch buffers are reused throughout, so the process touches 2 x 8 MB of fresh
+#: output memory instead of the whole output (556 MB first touched took 0.5-1.4 s on the 2-vCPU
+#: VM, touched again 0.03-0.07 s), a batch is still in the CPU's cache when the host reads it,
+#: and the device computes batch k+1 while batch k is written.  The 30k-patch PLY, median wall
+#: of 5 (load 11): 8 MB 2.65 s, 4 MB 2.91, 32 MB 3.35, one pass 4.6 (CPU the same within
+#: 0.1 s, one pass 0.2-0.3 s more).  bench/RESULTS.md, "Issue 15: the 30k-patch PLY (session 4)".
+STREAM_BATCH_BYTES = 8 << 20
 
 
 @dataclass
@@ -56,7 +67,7 @@ def default_budget(device: cl.Device) -> int:
 
 def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = None,
                        weld: bool = False, uv: str = "drop", on_plan=None, on_batch=None, progress=None,
-                       verify: bool = False, **options) -> StreamResult:
+                       verify: bool = False, batch_bytes: int | None = None, **options) -> StreamResult:
     """Tessellate ``scene`` into ``path`` (.ply, .obj, .stl, .glb or .npz) within ``max_memory_bytes``.
 
     options: eps / pixels / max_factor / forward_differencing, as for ``Tessellator.tessellate``.
@@ -69,6 +80,8 @@ def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = 
     progress(stage, done, total): called as batches are written.
     verify: measure the error of every batch on the device (``Tessellator.verify``); the stats
     (and a .npz file's stats_json) carry "verify_ratio" and where it occurs.
+    batch_bytes: output per batch of a streamed .ply at most (None: STREAM_BATCH_BYTES;
+    0: as much as the budget allows, one pass if the output fits); the file is the same.
     """
     path = Path(path)
     extension = check_extension(path)
@@ -81,6 +94,12 @@ def tessellate_to_file(tessellator, scene, path, max_memory_bytes: int | None = 
         ranges = plan.batch_ranges(max(budget // COPIES_IN_FLIGHT, 1))
     except OutputTooLarge as error:
         raise OutputTooLarge(f"{error} (a batch may take a third of the memory cap, {budget} bytes)") from None
+    batch_bytes = STREAM_BATCH_BYTES if batch_bytes is None else batch_bytes
+    if not weld and extension == ".ply" and 0 < batch_bytes < budget // COPIES_IN_FLIGHT:
+        try:  # smaller batches than the budget allows: for speed (unless a patch alone is larger)
+            ranges = plan.batch_ranges(batch_bytes)
+        except OutputTooLarge:
+            pass
     if weld or extension not in STREAMING_WRITERS or (extension == ".npz" and len(ranges) == 1):
         if len(ranges) > 1:
             why = "a welded mesh is built in memory" if weld else f"{extension} cannot be streamed"

@@ -358,6 +358,20 @@ def test_unknown_device_exits_1_listing_devices(capsys, tmp_path, scene_file, fa
     assert fake_pipeline.calls == []
 
 
+def test_a_scene_error_is_reported_before_a_device_error(capsys, tmp_path, fake_pipeline):
+    """The device opens on a thread while the scene loads: with both wrong, the scene's error
+    is the one reported (exit 2), as when they ran one after the other, and no thread is left."""
+    import threading
+
+    code, _, err = run(capsys, "tessellate", tmp_path / "missing.bez", "--eps", "1e-3", "--device", "no-such-gpu",
+                       "-o", tmp_path / "out.ply")
+    assert code == 2
+    assert_clean_error(err, "missing.bez")
+    assert "no-such-gpu" not in err
+    assert not [t for t in threading.enumerate() if t.name == "cltess-opencl"]
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_interrupt_during_export_leaves_no_file(capsys, tmp_path, scene_file, fake_pipeline, monkeypatch):
     def interrupted(fd):
         raise KeyboardInterrupt
@@ -423,9 +437,27 @@ def test_python_dash_m_runs(tmp_path):
     assert result.stdout.startswith("cltess ")
 
 
-def test_console_script_points_at_main():
+def test_console_script_points_at_run():
     import tomllib
 
     scripts = tomllib.loads((REPO / "pyproject.toml").read_text())["project"]["scripts"]
     module, function = scripts["cltess"].split(":")
-    assert (module, function) == ("cltess.cli", "main") and cli.main is main
+    assert (module, function) == ("cltess.cli", "run") and cli.main is main
+
+
+@pytest.mark.parametrize("quick", ["1", "0"])
+def test_quick_exit_keeps_the_output_the_summary_and_the_code(tmp_path, quick):
+    """``python -m cltess`` (run(): os._exit after tessellate) prints the whole summary, leaves
+    the complete file and no temporary one, and exits with main's code, as without it."""
+    import subprocess
+
+    env = dict(os.environ, CLTESS_QUICK_EXIT=quick)
+    output = tmp_path / "teapot.ply"
+    done = subprocess.run([sys.executable, "-m", "cltess", "tessellate", str(REPO / "scenes" / "teapot.bez"),
+                           "--eps", "0.01", "--no-weld", "-o", str(output)], capture_output=True, text=True, env=env)
+    assert done.returncode == 0, done.stderr
+    assert "triangles" in done.stdout and str(output) in done.stdout
+    assert [p.name for p in tmp_path.iterdir()] == ["teapot.ply"] and output.stat().st_size > 1000
+    bad = subprocess.run([sys.executable, "-m", "cltess", "tessellate", str(tmp_path / "missing.bez"), "--eps",
+                          "0.01", "-o", str(tmp_path / "x.ply")], capture_output=True, text=True, env=env)
+    assert bad.returncode == 2 and "cltess: error:" in bad.stderr and "missing.bez" in bad.stderr

@@ -9,7 +9,7 @@ import pytest
 
 from cltess.io import load_scene
 from cltess.limits import OutputTooLarge
-from cltess.stream import parse_size, tessellate_to_file
+from cltess.stream import COPIES_IN_FLIGHT, STREAM_BATCH_BYTES, parse_size, tessellate_to_file
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
 MiB = 2**20
@@ -20,7 +20,11 @@ STATED_OVERHEAD = 40 * MiB
 PEAK_RSS = r"""
 import re, sys
 from pathlib import Path
+import cltess.stream
 from cltess.cli import main
+if "--single-pass" in sys.argv:  # the whole output in one batch, as the budget allows
+    sys.argv.remove("--single-pass")
+    cltess.stream.STREAM_BATCH_BYTES = 0
 code = main(["tessellate"] + sys.argv[1:] + ["-q", "--no-weld"])  # per-patch output streams
 # VmHWM, not ru_maxrss: Linux carries ru_maxrss over execve from the parent process.
 print(int(re.search(r"VmHWM:\s+(\d+) kB", Path("/proc/self/status").read_text()).group(1)) * 1024)
@@ -44,14 +48,18 @@ def test_streaming_under_a_16mb_cap_matches_single_pass_and_bounds_memory(tmp_pa
     peak_rss(scene, *options, "--max-memory", "16M", "-o", tmp_path / "warm-up.ply")
     baseline = peak_rss(SCENES / "teapot.bez", "--eps", "0.1", "-o", tmp_path / "tiny.ply")
     streamed = peak_rss(scene, *options, "--max-memory", "16M", "-o", tmp_path / "streamed.ply")
-    single = peak_rss(scene, *options, "-o", tmp_path / "single.ply")
+    single = peak_rss(scene, *options, "--single-pass", "-o", tmp_path / "single.ply")
+    default = peak_rss(scene, *options, "-o", tmp_path / "default.ply")  # batches of STREAM_BATCH_BYTES
     size = (tmp_path / "streamed.ply").stat().st_size
     print(f"output {size / MiB:.0f} MiB; peak RSS above a tiny run: streamed "
-          f"{(streamed - baseline) / MiB:.1f} MiB under a 16 MiB cap, single pass {(single - baseline) / MiB:.1f} MiB")
+          f"{(streamed - baseline) / MiB:.1f} MiB under a 16 MiB cap, single pass {(single - baseline) / MiB:.1f} MiB, "
+          f"default {(default - baseline) / MiB:.1f} MiB")
     assert size >= 8 * cap
     assert (tmp_path / "streamed.ply").read_bytes() == (tmp_path / "single.ply").read_bytes()
+    assert (tmp_path / "default.ply").read_bytes() == (tmp_path / "single.ply").read_bytes()
     assert streamed - baseline <= cap + STATED_OVERHEAD
     assert single - baseline > 2 * (cap + STATED_OVERHEAD)  # the cap is what made the difference
+    assert default - baseline <= COPIES_IN_FLIGHT * STREAM_BATCH_BYTES + STATED_OVERHEAD
 
 
 @pytest.mark.parametrize("suffix", [".ply", ".obj"])
@@ -60,7 +68,7 @@ def test_streamed_files_equal_single_pass_files(tessellator, tmp_path, suffix):
     written, and OBJ writes v, vt, vn per vertex)."""
     scene = load_scene(SCENES / "teapot.bez")
     streamed = tessellate_to_file(tessellator, scene, tmp_path / f"a{suffix}", max_memory_bytes=900_000, eps=0.002)
-    single = tessellate_to_file(tessellator, scene, tmp_path / f"b{suffix}", eps=0.002)
+    single = tessellate_to_file(tessellator, scene, tmp_path / f"b{suffix}", eps=0.002, batch_bytes=0)
     assert streamed.batches > 3 and single.batches == 1
     assert streamed.stats == single.stats
     assert (tmp_path / f"a{suffix}").read_bytes() == (tmp_path / f"b{suffix}").read_bytes()

@@ -62,10 +62,10 @@ WELD_SECONDS_PER_TRIANGLE, T_JUNCTION_SECONDS_PER_TRIANGLE = 2e-6, 6e-6
 def estimate_write_seconds(extension: str, size: int, num_triangles: int = 0, weld: bool = False) -> float:
     """About how long writing ``size`` bytes in this format takes (welding included), from the
     speeds measured above: an order of magnitude, not a promise."""
-    from ..weld import T_JUNCTION_CHECK_LIMIT
-
     seconds = size / (WRITE_MIB_PER_SECOND[extension.lower()] * 2**20)
     if weld:
+        from ..weld import T_JUNCTION_CHECK_LIMIT  # here: cltess.weld imports 10 ms of modules
+
         seconds += num_triangles * WELD_SECONDS_PER_TRIANGLE
         if num_triangles <= T_JUNCTION_CHECK_LIMIT:
             seconds += num_triangles * T_JUNCTION_SECONDS_PER_TRIANGLE

@@ -8,6 +8,7 @@ import sys
 import numpy as np
 
 from ..tessellation import VERTEX_RECORD, Tessellation
+from .direct import BlockFile
 from .writing import _StreamingWriter, _vertex_arrays, atomic_write
 
 #: The PLY property names of each field of the vertex record (cltess.tessellation.VERTEX_RECORD).
@@ -94,30 +95,55 @@ class PlyWriter(_StreamingWriter):
 
     Vertex element: ``float x y z nx ny nz u v``, ``int patch object``.
     Face element: ``list uchar uint vertex_indices``.
-    Face blocks that arrive before the last vertex block are spooled to an anonymous
-    temporary file and appended after the vertices when the writer closes.
+    The totals fix where everything goes: the header, then the vertex records, then the face
+    records, each a region of the file (``io.direct.BlockFile``) filled in the order its blocks
+    arrive, so face blocks may come before the last vertex block.  The records are built in
+    place in the regions' aligned staging buffers and written by direct I/O where the file
+    system allows it (bypassing the page cache; ``CLTESS_DIRECT_IO=off`` turns it off).
     """
 
     def header(self) -> bytes:
         return ply_header(self.num_vertices, self.num_faces)
 
     def _write_header(self) -> None:
-        self._file.write(self.header())
+        header = self.header()
+        vertex_bytes = self.num_vertices * PLY_VERTEX_DTYPE.itemsize
+        face_bytes = self.num_faces * PLY_FACE_DTYPE.itemsize
+        self._blocks = BlockFile(self._file.fileno(), len(header) + vertex_bytes + face_bytes)
+        self._blocks.region(0, len(header)).write(header)
+        self._vertex_region = self._blocks.region(len(header), vertex_bytes)
+        self._face_region = self._blocks.region(len(header) + vertex_bytes, face_bytes)
 
     def write_vertices(self, block) -> None:
         """Append vertices: ``block`` has positions (k,3), normals (k,3), uv (k,2), patch_ids, object_ids (k,)."""
         arrays = self._take_vertices(block)
-        out = np.empty(min(len(arrays.positions), CHUNK_RECORDS), PLY_VERTEX_DTYPE)
-        for first in range(0, len(arrays.positions), CHUNK_RECORDS):
-            last = min(first + CHUNK_RECORDS, len(arrays.positions))
-            self._file.write(_vertex_records(arrays, first, last, out).view(np.uint8))
+        step = min(CHUNK_RECORDS, self._vertex_region.capacity // PLY_VERTEX_DTYPE.itemsize)
+        for first in range(0, len(arrays.positions), step):
+            last = min(first + step, len(arrays.positions))
+            nbytes = (last - first) * PLY_VERTEX_DTYPE.itemsize
+            _vertex_records(arrays, first, last, self._vertex_region.reserve(nbytes).view(PLY_VERTEX_DTYPE))
+            self._vertex_region.commit(nbytes)
 
     def write_faces(self, triangles) -> None:
         """Append faces: (k, 3) global, 0-based vertex indices."""
         faces = self._take_faces(triangles)
-        out = np.empty(min(len(faces), CHUNK_RECORDS), PLY_FACE_DTYPE)
-        for first in range(0, len(faces), CHUNK_RECORDS):
-            self._put_faces(ply_face_records(faces[first:first + CHUNK_RECORDS], out).view(np.uint8))
+        step = min(CHUNK_RECORDS, self._face_region.capacity // PLY_FACE_DTYPE.itemsize)
+        for first in range(0, len(faces), step):
+            chunk = faces[first:first + step]
+            nbytes = len(chunk) * PLY_FACE_DTYPE.itemsize
+            ply_face_records(chunk, self._face_region.reserve(nbytes).view(PLY_FACE_DTYPE))
+            self._face_region.commit(nbytes)
+
+    def _finish(self) -> None:
+        self._check_totals()
+        self._blocks.finish()
+        self._blocks.close()
+
+    def _abort(self, error: BaseException) -> None:
+        blocks = getattr(self, "_blocks", None)
+        if blocks is not None:
+            blocks.close()
+        super()._abort(error)
 
 
 def write_ply(tess: Tessellation, path) -> None:

@@ -7,6 +7,7 @@ from __future__ import annotations
 import contextlib
 import os
 import shutil
+import stat
 import tempfile
 from pathlib import Path
 from typing import IO, Iterator, NamedTuple
@@ -50,7 +51,10 @@ def atomic_write(path: str | os.PathLike, mode: str = "wb", **open_kwargs) -> It
             yield handle
             handle.flush()
             os.fsync(handle.fileno())
+        old = _hold_large(target)
         os.replace(temp_name, target)
+        if old is not None:
+            _release_elsewhere(old)
     except BaseException as error:
         if handle is None:
             os.close(fd)  # open() never took the descriptor over
@@ -59,6 +63,58 @@ def atomic_write(path: str | os.PathLike, mode: str = "wb", **open_kwargs) -> It
         if isinstance(error, OSError) and error.filename in (None, temp_name):
             raise _naming(error, target) from error
         raise
+
+
+#: A replaced file at least this large has its blocks freed by a helper process (``_release_elsewhere``).
+RELEASE_ELSEWHERE_BYTES = 64 << 20
+
+
+def _hold_large(target: Path) -> int | None:
+    """A descriptor holding the file that ``target`` names now (not following a link), if it is
+    a regular file of at least RELEASE_ELSEWHERE_BYTES; else None."""
+    if not hasattr(os, "O_PATH"):
+        return None
+    try:
+        fd = os.open(target, os.O_PATH | os.O_NOFOLLOW)
+    except OSError:
+        return None
+    try:
+        info = os.fstat(fd)
+        if stat.S_ISREG(info.st_mode) and info.st_size >= RELEASE_ELSEWHERE_BYTES and info.st_nlink == 1:
+            return fd
+    except OSError:
+        pass
+    os.close(fd)
+    return None
+
+
+_HELPERS: list = []  # the helpers of _release_elsewhere not yet seen to end
+
+
+def _release_elsewhere(fd: int) -> None:
+    """Close ``fd``, the last reference to a file just replaced, so that freeing its blocks
+    happens in a helper process, not here: freeing a 556 MB file took 0.14-0.25 s on the VM of
+    bench/RESULTS.md ("Issue 15: the 30k-patch PLY"; ext4 mounted with ``discard``), after the
+    output was complete.  The helper (``cat`` reading a pipe) holds a copy of ``fd``; ours is
+    closed first, then the pipe, so the helper's exit is the last close.  Where no helper can be
+    started, the plain close."""
+    import subprocess
+
+    try:
+        reading, writing = os.pipe()
+    except OSError:
+        os.close(fd)
+        return
+    _HELPERS[:] = [helper for helper in _HELPERS if helper.poll() is None]  # reaped when done
+    try:
+        _HELPERS.append(subprocess.Popen(["cat"], stdin=reading, stdout=subprocess.DEVNULL,
+                                         stderr=subprocess.DEVNULL, pass_fds=(fd,), start_new_session=True))
+    except (OSError, ValueError, subprocess.SubprocessError):
+        pass
+    finally:
+        os.close(reading)
+        os.close(fd)  # the helper's copy keeps the file
+        os.close(writing)  # the helper sees the end of its input and exits
 
 
 def _naming(error: OSError, target: Path) -> OSError:
@@ -89,8 +145,9 @@ def _face_array(triangles, num_vertices: int) -> np.ndarray:
     triangles = np.asarray(triangles)
     if triangles.ndim != 2 or triangles.shape[1] != 3:
         raise ValueError(f"triangles must have shape (n, 3), got {triangles.shape}")
-    if len(triangles):
-        low, high = int(triangles.min()), int(triangles.max())
+    if len(triangles):  # unsigned indices (the device's): no pass for the minimum
+        low = 0 if triangles.dtype.kind == "u" else int(triangles.min())
+        high = int(triangles.max())
         if low < 0 or high >= num_vertices:
             raise ValueError(f"triangle indices span [{low}, {high}], outside [0, {num_vertices})")
     return np.ascontiguousarray(triangles, dtype=np.uint32)
