@@ -140,8 +140,15 @@ def main(argv=None) -> int:
     lanes_stored = build(context, device, kernel_dir(), probe_source, "vertices", part.pattern, forms + ("STORE_LANES",))
     octets = (16 - 1 + 7) // 8  # rows of a level-16 patch, 8 per work-item
 
-    def launch_stage4(kernel):
-        return lambda: kernel(queue, per_patch, None, *common, *buffers)
+    def launch_stage4(kernel):  # the engine's kernel takes its output's capacity (batch_fits); a tree before not
+        capacity = (np.uint64(vertices),) if kernel.num_args == len(common) + 1 + len(buffers) else ()
+        return lambda: kernel(queue, per_patch, None, *common, *capacity, *buffers)
+
+    def launch_stage5(kernel):
+        capacity = (np.uint64(plan.num_indices),) if kernel.num_args == 8 else ()
+        return lambda: kernel(queue, per_patch, None, plan.factors.data, plan.vertex_offsets.data,
+                              plan.index_offsets.data, np.uint32(0), np.uint32(patches), np.uint64(0), *capacity,
+                              triangles.data)
 
     for rep in range(2):  # two rounds, interleaved, so that the load's drift touches every figure
         suffix = "" if rep == 0 else " (again)"
@@ -150,9 +157,7 @@ def main(argv=None) -> int:
         for label, (vertices_kernel, indices_kernel) in kernels.items():
             measure(f"{label}stage 4 (vertices){suffix}", launch_stage4(vertices_kernel))
             record.setdefault("digests", {})[f"{label}stage 4"] = digest(out)
-            measure(f"{label}stage 5 (indices){suffix}", lambda: indices_kernel(
-                queue, per_patch, None, plan.factors.data, plan.vertex_offsets.data, plan.index_offsets.data,
-                np.uint32(0), np.uint32(patches), np.uint64(0), triangles.data))
+            measure(f"{label}stage 5 (indices){suffix}", launch_stage5(indices_kernel))
             record["digests"][f"{label}stage 5"] = digest([triangles])
         for buffer in buffers:
             cl.enqueue_fill_buffer(queue, buffer, np.zeros(1, np.uint8), 0, buffer.size)
