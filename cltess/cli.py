@@ -567,16 +567,16 @@ def cmd_tessellate(args) -> int:
     if args.uv == "seam" and output.suffix.lower() not in (".ply", ".obj", ".npz"):
         raise UsageError(f"{output}: --uv seam can be written to .ply, .obj or .npz only")
     preview = _check_preview(args.preview, args.scene) if args.preview else None
+    # The scene first, then the device, one after the other.  (Opening OpenCL on a thread while
+    # the scene loads was tried: Python's warning filters are one global list, and the text
+    # parser's catch_warnings(simplefilter("error")) turned pyopencl's compiler-output warning on
+    # the other thread into an exception, which pyopencl's cache reports as a KeyError.)
+    scene, orientation, eps_text = _prepare_scene(args)
+    device = pick_device(args.device)
+
     from cltess.pipeline import Tessellator  # lazy: builds OpenCL programs
 
-    opening = _in_background(lambda: Tessellator(device=pick_device(args.device)))
-    try:  # the scene loads while the OpenCL runtime starts (C code: the GIL is free)
-        scene, orientation, eps_text = _prepare_scene(args)
-    except BaseException:
-        opening.join()  # nothing left running; the scene's error is the one reported
-        raise
-    tessellator = opening.result()
-    device = tessellator.device
+    tessellator = Tessellator(device=device)
     mesh_options = {"sharp_edges": args.sharp_edges} if scene.meshes else {}
     mesh_options.update(_level_options(args, scene))
     def before_writing(plan):
@@ -641,32 +641,6 @@ def cmd_tessellate(args) -> int:
         print(format_summary(result.stats, result.stage_ms, scene=args.scene, device=device.name.strip(),
                              tolerance=eps_text, output=output if preview is None else f"{output}, {preview}"))
     return EXIT_OK
-
-
-class _in_background:
-    """``make()`` on a thread started now; ``result()`` joins it and returns its value or
-    raises its exception.  For the OpenCL start-up (platforms, context: 0.1-0.2 s of C code
-    that releases the GIL), overlapped with the scene's loading."""
-
-    def __init__(self, make):
-        self._value, self._error = None, None
-        self._thread = threading.Thread(target=self._run, args=(make,), name="cltess-opencl", daemon=True)
-        self._thread.start()
-
-    def _run(self, make):
-        try:
-            self._value = make()
-        except BaseException as error:  # handed to result()
-            self._error = error
-
-    def join(self) -> None:
-        self._thread.join()
-
-    def result(self):
-        self._thread.join()
-        if self._error is not None:
-            raise self._error
-        return self._value
 
 
 def cmd_tessellate_frames(args) -> int:
