@@ -16,16 +16,13 @@ subprocesses (``tests/oclgrind_scenarios.py``), two of them, one per pass:
                    context per scenario and zero-fills done by copy.
 
 Any report fails, but for two from pyopencl's scan kernels, matched narrowly
-(``oclgrind_scenarios.ALLOWED``).  Together both passes take 30-40 s on 2 cores.
+(``oclgrind_scenarios.ALLOWED``).  Both passes start in the background when the tests are
+collected and these tests run last (``conftest.py``, ``support/oclgrind_passes.py``): the
+simulator keeps one core busy for minutes while the rest of the suite uses the other.
 """
 from __future__ import annotations
 
-import json
 import os
-import subprocess
-import sys
-from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -33,35 +30,10 @@ import pytest
 import oclgrind_scenarios as scenarios
 from cltess.device import list_devices
 from cltess.io.npz import load_npz
+from support import oclgrind_passes as passes
 
-HERE = Path(__file__).resolve().parent
-NAMES = [*scenarios.SCENARIOS, *scenarios.BATCHED, *scenarios.BY_LEVEL, *scenarios.ROWS_IN_PARALLEL, *scenarios.POINTS,
-         *scenarios.SILHOUETTE, *scenarios.FUSED_OFFSETS, *scenarios.FRAMES]
-
-PASSES = {
-    "checks": dict(env=scenarios.OCLGRIND_ENV, args=[],
-                   selftests={"selftest_oob_write": "Invalid write of size 4",
-                              "selftest_race": "Write-write data race"}),
-    "uninitialized": dict(env=scenarios.OCLGRIND_UNINITIALIZED_ENV, args=["--fill-by-copy", "--fresh-context"],
-                          selftests={"selftest_oob_write": "Invalid write of size 4",
-                                     "selftest_uninitialized": "Uninitialized value written to global memory"}),
-}
-TIMEOUT_S = 1200  # per pass; they take ~10 s and ~90 s alone on 2 vCPUs (far more under load)
-
-
-@dataclass
-class Run:
-    """One pass: the runner's exit code, its per-scenario JSON lines, Oclgrind's reports
-    by scenario (allowed ones dropped), raw stderr and the folder of the .npz meshes."""
-
-    returncode: int
-    results: dict
-    reports: dict
-    stderr: str
-    out_dir: Path
-
-
-_RUNS: dict[str, Run] = {}
+NAMES = passes.NAMES
+PASSES = passes.PASSES
 
 
 def oclgrind_missing() -> str | None:
@@ -80,38 +52,15 @@ def oclgrind():
         pytest.skip(missing)
 
 
-def pass_names(name: str) -> list[str]:
-    """What a pass runs: every scenario (the uninitialised-value pass leaves out the ones it
-    skips, UNINITIALIZED_SKIPPED, to save their simulation time) and the pass's self-tests."""
-    skipped = scenarios.UNINITIALIZED_SKIPPED if name == "uninitialized" else {}
-    return [*(n for n in NAMES if n not in skipped), *PASSES[name]["selftests"]]
+def run_pass(name: str, tmp_path_factory, names=None) -> passes.Run:
+    """Pass ``name``: the full pass (started in the background by conftest.py, or now), or only
+    ``names``, run now."""
+    if names is None:
+        return passes.full_pass(name, tmp_path_factory.mktemp(f"oclgrind-{name}"))
+    return passes.finish(passes.start(name, tmp_path_factory.mktemp(f"oclgrind-{name}"), names))
 
 
-def run_pass(name: str, tmp_path_factory, names=None) -> Run:
-    """Run one pass (cached per session) of ``names`` (default: ``pass_names``) in a
-    subprocess."""
-    if names is None and name in _RUNS:
-        return _RUNS[name]
-    spec = PASSES[name]
-    names = names or pass_names(name)
-    out_dir = tmp_path_factory.mktemp(f"oclgrind-{name}")
-    env = {k: v for k, v in os.environ.items() if not k.startswith(("OCLGRIND_", "PYOPENCL_BUILD"))}
-    env.update(spec["env"], CLTESS_DEVICE="oclgrind", OCLGRIND_MAX_ERRORS="1000000")
-    process = subprocess.run(
-        [sys.executable, str(HERE / "oclgrind_scenarios.py"), *spec["args"], "--out", str(out_dir), *names],
-        capture_output=True, text=True, env=env, timeout=TIMEOUT_S)
-    results = {}
-    for line in process.stdout.splitlines():
-        record = json.loads(line)
-        if "name" in record:
-            results[record["name"]] = record
-    run = Run(process.returncode, results, scenarios.parse_stderr(process.stderr), process.stderr, out_dir)
-    if names == pass_names(name):
-        _RUNS[name] = run
-    return run
-
-
-def problems(run: Run, name: str) -> list[str]:
+def problems(run: passes.Run, name: str) -> list[str]:
     """Why scenario ``name`` of ``run`` fails: it did not finish, or Oclgrind reported."""
     found = []
     if name not in run.results:
