@@ -7,7 +7,9 @@ For a triangle T with corners x_i, barycentric coordinates l_i(x) and h_i = x_i 
     |p(x) - l(x)| <= sum_i l_i(x) int_0^1 (1 - t) |D^2 p(x + t h_i)[h_i, h_i]| dt,
 
 and |D^2 p(xi)[h, h]| <= m_uu h_u^2 + 2 m_uv |h_u h_v| + m_vv h_v^2 with m_ab the hull bound
-(Lemma 2) of the S x S subpatches meeting a box around xi.  Upper sums over K^2 sub-triangles
+(Lemma 2) of the S x S subpatches meeting a box around xi, or by the square root of the
+direction-aware quartic bound over those cells (``direction_form``; docs/rational-bound.md,
+"The direction-aware form per cell"), whichever is smaller.  Upper sums over K^2 sub-triangles
 and [0, 1] cut in T intervals turn it into a number per triangle; every step is an inequality.
 
 The host part: ``subpatch_majorants`` (float64 de Casteljau subdivision of the (9, 9) nets by
