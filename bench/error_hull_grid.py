@@ -157,7 +157,8 @@ def main(argv=None) -> None:
         return test
 
     print(f"eps {args.eps:g} of the diagonal, depth {args.depth}")
-    print("| patch | certified: triangles (m x n) | boxes evaluated |" + (" measured within eps: triangles (m x n) |" if args.ideal else ""))
+    ideal_header = " measured within eps: triangles (m x n) |" if args.ideal else ""
+    print("| patch | certified: triangles (m x n) | boxes evaluated |" + ideal_header)
     print("|---|---|---|" + ("---|" if args.ideal else ""))
     total = ideal_total = 0
     for index in args.patches:
