@@ -43,6 +43,7 @@ def test_host_and_device_constants_agree():
     assert float(define("INTEGRAL_BOX_WIDENING")) == integral.BOX_WIDENING
     assert int(define("INTEGRAL_QUERY_SPAN")) == integral.QUERY_SPAN
     assert np.float32(define("INTEGRAL_BOUND_SAFETY")) == np.float32(integral.BOUND_SAFETY)
+    assert np.float32(define("INTEGRAL_QUARTIC_SLACK")) == np.float32(integral.QUARTIC_SLACK)
     assert int(define("INTEGRAL_GRADED_SPAN")) == integral.GRADED_SPAN
     k = integral.SUBDIVISIONS  # the kernel doubles K from the first to the last
     assert all(b == 2 * a for a, b in zip(k, k[1:]))
@@ -104,7 +105,46 @@ def test_graded_cells_hold_and_the_table_is_no_looser(rng):
             found = np.array([np.linalg.norm(d, axis=1).max() for d in second_derivatives(patch, u, v)])
             assert (found <= graded[j, i]).all(), (j, i)
         direct = integral.majorant_pyramid(integral.subpatch_majorants(patch, levels))
-        assert (table[:integral.pyramid_cells(levels)] <= direct).all()
+        assert (table[:integral.pyramid_cells(levels), :3] <= direct[:, :3]).all()
+        # the quartic columns: never above what the norms' triangle inequality gives
+        assert (table[:integral.pyramid_cells(levels), 3:] <= direct[:, 3:] * (1 + 1e-5) + 1e-30).all()
+
+
+def test_direction_aware_form_holds_and_is_no_looser(rng):
+    """The direction-aware form (docs/rational-bound.md, "The direction-aware form per cell"):
+    for boxes of h and cells of the graded table, direction_form(cell's columns, the box's
+    monomial ranges) >= |D^2 p(xi)[h, h]| sampled densely (xi in the cell, h in the box), and
+    never above the norms' form m_uu H_u^2 + 2 m_uv H_u H_v + m_vv H_v^2 (H: the box's largest
+    |h| per axis) beyond float32 rounding; and it is strictly smaller somewhere (not idle)."""
+    sys.path.insert(0, str(SCENES.parent / "bench"))
+    from ratio_floor import second_derivatives
+
+    levels = 3
+    breaks = integral.graded_breaks(levels)
+    count = len(breaks) - 1
+    tighter = 0
+    for patch in random_patches(rng, 2):
+        table = integral.patch_table(patch, levels)
+        graded = table[integral.pyramid_cells(levels):].reshape(count, count, integral.TABLE_WIDTH)
+        for j, i in [(0, 0), (count - 1, 0), (count // 2, count // 2)] + [tuple(c) for c in rng.integers(0, count, (4, 2))]:
+            u, v = (x.ravel() for x in np.meshgrid(np.linspace(breaks[i], breaks[i + 1], 5),
+                                                   np.linspace(breaks[j], breaks[j + 1], 5)))
+            d_uu, d_uv, d_vv = second_derivatives(patch, u, v)
+            for _ in range(6):
+                centre = rng.normal(size=2)
+                half = np.abs(rng.normal(size=2)) * rng.choice([0.01, 0.3, 2.0])
+                lo, hi = (centre - half).astype(np.float32), (centre + half).astype(np.float32)
+                form = float(integral.direction_form(graded[j, i], integral.monomial_ranges(lo, hi)))
+                h_u, h_v = (x.ravel() for x in np.meshgrid(np.linspace(lo[0], hi[0], 5), np.linspace(lo[1], hi[1], 5)))
+                values = (d_uu[:, None] * (h_u * h_u)[None, :, None] + 2 * d_uv[:, None] * (h_u * h_v)[None, :, None]
+                          + d_vv[:, None] * (h_v * h_v)[None, :, None])
+                assert np.linalg.norm(values, axis=-1).max() <= form, (j, i)
+                m = graded[j, i].astype(float)
+                big = np.maximum(np.abs(lo), np.abs(hi)).astype(float)
+                norms = m[0] * big[0] ** 2 + 2 * m[1] * big[0] * big[1] + m[2] * big[1] ** 2
+                assert form <= norms * (1 + 1e-4)
+                tighter += form < 0.9 * norms
+    assert tighter > 0
 
 
 def test_graded_tables_cut_the_corner_spike_patches(tessellator):

@@ -1,6 +1,6 @@
 /* On request (Request(bound="integral")): the integral-form bound of every emitted triangle of
  * the patches marked in `check` (criteria/integral_bound.h; mirror cltess.criteria.integral
- * triangle_bound).  `cells`: float4 rows of one patch's table (pyramid and graded cells, integral.table_cells),
+ * triangle_bound).  `cells`: float8 rows of one patch's table (pyramid and graded cells, integral.table_cells),
  * `breaks`: the graded cells' breakpoints (graded_count + 1).  One work-item per triangle of the output (triangles index it, uv its
  * vertices' (u, v), patch_ids its vertices' scene patch); writes bound / tolerance of the
  * triangle's patch, or 0 where the patch has no table (pyramid_of < 0) or is not checked, and
@@ -11,7 +11,7 @@
  * a vector type hint turns that vectorisation off.  The padding work-items compute the last
  * triangle again and store nothing. */
 __kernel __attribute__((vec_type_hint(float4))) void integral_bound(
-    __global const float4 *pyramids, __global const int *pyramid_of, __global const int *check,
+    __global const float8 *pyramids, __global const int *pyramid_of, __global const int *check,
     __global const float *uv, __global const int *patch_ids, __global const uint *triangles,
     uint num_triangles, int levels, int cells, __global const float *breaks, int graded_count, int k_first, int k_last,
     __global const float *tolerances, __global float *ratios, __global volatile int *patch_worst,
