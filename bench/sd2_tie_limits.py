@@ -1,0 +1,167 @@
+"""Issue 13, session 5: what the "Third pass" argument of docs/sd2.md section 5 does and does not
+forbid, checked combinatorially on the SD-2 fan (NumPy only, no device).
+
+(A) Native collapse.  The fan with tip c (a = b = n, the paper's strips, no centres) mapped onto the
+    lattice of the grid (labels (i_0, i_1, i_2), sum n) by M_c: vertex (i, j) -> corner c index n - i,
+    corner c+1 index n - j (clamped onto edge (c, c+1) when i + j < n).  Checked: every fan triangle
+    with three distinct labels is a grid triangle, each grid triangle is hit exactly once with the
+    same orientation, and every other fan triangle has two equal labels whose pair is a lattice edge
+    (so it is degenerate in 3D too: no fins).  Labels only, so this holds for ANY positions of the
+    grid's points: fan c reaches every grid configuration without centres, whichever corner ties.
+    The same map with partner c+2 (vertex (i, j) -> corner c index n - i, corner c+2 index j) is
+    also checked: it needs the other diagonal (today's centres), so it fails here.
+(B) Births.  A configuration reached by fan c with its rows and columns on the edges' fractional
+    points (location-based, continuous where a factor crosses an odd number) is a product in the
+    indices of corners c and c+1: as F -> m+ (odd m) lattice point p of n = m + 2 tends to the
+    m-lattice point with indices (p_c', p_{c+1}') (k' the merged index of fractional_odd).  Counted:
+    lattice points where the limits for two tips differ.  If any, no single grid configuration is
+    such a product for both fans of a wall, so one of them must reach it with the other diagonal
+    (the flip that pops near a triple point, docs/sd2.md "Third pass").
+
+    python bench/sd2_tie_limits.py [--max-n 15] [--max-m 15]
+"""
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+from cltess.patterns.fractional import locations, to_fixed
+
+
+def fan_triangles(n: int):
+    """The paper's fan (a = b = n) as (i, j) index triples, counter-clockwise as sd2_pattern emits
+    them (strip [tip, (1,j), (1,j+1), ..., (n,j), (n,j+1)], odd triangles swapped)."""
+    triangles = []
+    for j in range(n):
+        strip = [(0, 0)] + [v for i in range(1, n + 1) for v in ((i, j), (i, j + 1))]
+        for k in range(len(strip) - 2):
+            a, b, c = strip[k], strip[k + 1], strip[k + 2]
+            triangles.append((b, a, c) if k % 2 else (a, b, c))
+    return triangles
+
+
+def native_label(c: int, n: int, i: int, j: int) -> tuple:
+    """Lattice label of fan-c vertex (i, j) under the native map (partner c+1)."""
+    idx = [0, 0, 0]
+    idx[c] = n - i
+    if i + j >= n:
+        idx[(c + 1) % 3], idx[(c + 2) % 3] = n - j, i + j - n
+    else:
+        idx[(c + 1) % 3] = i
+    return tuple(idx)
+
+
+def flipped_label(c: int, n: int, i: int, j: int) -> tuple:
+    """Lattice label of fan-c vertex (i, j) with partner c+2 (today's lam = 0 map)."""
+    idx = [0, 0, 0]
+    idx[c] = n - i
+    if j < i:
+        idx[(c + 1) % 3], idx[(c + 2) % 3] = i - j, j
+    else:
+        idx[(c + 2) % 3] = i
+    return tuple(idx)
+
+
+def grid_triangles(n: int) -> set:
+    """The lattice's n^2 triangles (up: i2 >= 1, down: i2 >= 2 below), each as a rotation-normalised
+    counter-clockwise label triple in (u, v) = (corner 1, corner 2 weights)."""
+    out = set()
+    for i0 in range(n + 1):
+        for i1 in range(n + 1 - i0):
+            i2 = n - i0 - i1
+            if i2 >= 1:  # up triangle (i0, i1, i2) -> (i0+1, i1, i2-1) -> (i0, i1+1, i2-1)
+                out.add(_norm(((i0, i1, i2), (i0 + 1, i1, i2 - 1), (i0, i1 + 1, i2 - 1))))
+    # down triangles: (i0, i1+1, i2-1), (i0+1, i1, i2-1), (i0+1, i1+1, i2-2)
+    for i0 in range(n + 1):
+        for i1 in range(n + 1 - i0):
+            i2 = n - i0 - i1
+            if i2 >= 2:
+                out.add(_norm(((i0 + 1, i1, i2 - 1), (i0 + 1, i1 + 1, i2 - 2), (i0, i1 + 1, i2 - 1))))
+    return out
+
+
+def _xy(label, n):
+    """Domain (u, v) = (weight of corner 1, weight of corner 2) of a regular-lattice label."""
+    return np.array([label[1], label[2]], float) / n
+
+
+def _orient(tri, n):
+    a, b, c = (_xy(t, n) for t in tri)
+    return float((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
+
+
+def _norm(tri):
+    """The triple rotated to start at its smallest label (orientation kept)."""
+    k = tri.index(min(tri))
+    return tri[k:] + tri[:k]
+
+
+def check_collapse(label, c: int, n: int) -> tuple[bool, str]:
+    grid = grid_triangles(n)
+    hit = {}
+    for tri in fan_triangles(n):
+        labels = tuple(label(c, n, i, j) for i, j in tri)
+        distinct = set(labels)
+        if len(distinct) == 3:
+            if _orient(labels, n) <= 0:
+                return False, f"fan triangle {tri} -> {labels} not counter-clockwise"
+            key = _norm(labels)
+            if key not in grid:
+                return False, f"fan triangle {tri} -> {labels} is no grid triangle"
+            hit[key] = hit.get(key, 0) + 1
+        elif len(distinct) == 2:
+            p, q = sorted(distinct)
+            if sum(abs(x - y) for x, y in zip(p, q)) != 2:
+                return False, f"fan triangle {tri} collapses onto {p}-{q}, no lattice edge (a 3D fin/chord)"
+    if set(hit) != grid or any(v != 1 for v in hit.values()):
+        return False, f"grid covered {len(hit)}/{len(grid)} distinct, max multiplicity {max(hit.values())}"
+    return True, "ok"
+
+
+def merged_index(m: int) -> np.ndarray:
+    """k' of each point k of an edge of factor m + 1/65536 (n = m + 2): the m-lattice point it tends to."""
+    x = locations(int(to_fixed(m)) + 1).astype(np.float64)
+    return np.rint(x * m).astype(int)
+
+
+def birth_mismatches(m: int) -> dict:
+    """Lattice points (n = m + 2) whose limits as F -> m+ differ between the product maps of tips."""
+    km = merged_index(m)
+    n = m + 2
+    limits = {}
+    for i0 in range(n + 1):
+        for i1 in range(n + 1 - i0):
+            p = (i0, i1, n - i0 - i1)
+            lim = []
+            for c in range(3):
+                q = [None, None, None]
+                q[c], q[(c + 1) % 3] = km[p[c]], km[p[(c + 1) % 3]]
+                q[(c + 2) % 3] = m - q[c] - q[(c + 1) % 3]
+                lim.append(tuple(q))
+            limits[p] = lim
+    total = len(limits)
+    wall = {c: sum(1 for v in limits.values() if v[c] != v[(c + 1) % 3]) for c in range(3)}
+    outside = sum(1 for v in limits.values() if min(min(q) for q in v) < 0)
+    return {"points": total, "tips c, c+1 differ": wall, "a limit outside the triangle": outside}
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--max-n", type=int, default=15)
+    parser.add_argument("--max-m", type=int, default=15)
+    args = parser.parse_args(argv)
+    print("(A) fan c onto the grid lattice, labels only (any grid positions)")
+    for name, label in (("native, partner c+1", native_label), ("partner c+2, no centres", flipped_label)):
+        bad = [(c, n, why) for n in range(1, args.max_n + 1) for c in range(3)
+               for ok, why in [check_collapse(label, c, n)] if not ok]
+        print(f"  {name}: {3 * args.max_n - len(bad)} of {3 * args.max_n} (c, n) valid collapses"
+              + (f"; first failure c={bad[0][0]} n={bad[0][1]}: {bad[0][2]}" if bad else ""))
+    print("(B) births at odd m (F -> m+): lattice points of n = m + 2 whose product limits differ")
+    for m in range(1, args.max_m + 1, 2):
+        print(f"  m = {m}: {birth_mismatches(m)}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

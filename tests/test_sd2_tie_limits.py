@@ -1,0 +1,25 @@
+"""The collapse lemma behind docs/sd2.md section 5 "Fifth pass" (bench/sd2_tie_limits.py): the
+paper's fan with tip c collapses onto the grid lattice by its native map (partner c+1) for every n,
+labels only (so for any positions of the grid's points); the partner-c+2 map needs the other
+diagonal; and at every odd m the product limits of two tips' maps differ (the birth obstruction)."""
+import pytest
+
+from bench.sd2_tie_limits import birth_mismatches, check_collapse, flipped_label, native_label
+
+
+@pytest.mark.parametrize("n", range(1, 12))
+@pytest.mark.parametrize("c", range(3))
+def test_the_fan_collapses_natively_onto_the_grid(c, n):
+    ok, why = check_collapse(native_label, c, n)
+    assert ok, why
+
+
+@pytest.mark.parametrize("n", range(2, 8))
+def test_the_partner_c2_map_needs_the_other_diagonal(n):
+    assert not check_collapse(flipped_label, 0, n)[0]
+
+
+@pytest.mark.parametrize("m", [1, 3, 5, 7])
+def test_product_limits_of_two_tips_differ_at_every_birth(m):
+    counts = birth_mismatches(m)["tips c, c+1 differ"]
+    assert all(v > 0 for v in counts.values())
