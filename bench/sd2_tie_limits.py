@@ -18,7 +18,11 @@ forbid, checked combinatorially on the SD-2 fan (NumPy only, no device).
     such a product for both fans of a wall, so one of them must reach it with the other diagonal
     (the flip that pops near a triple point, docs/sd2.md "Third pass").
 
-    python bench/sd2_tie_limits.py [--max-n 15] [--max-m 15]
+(C) Fold-over of the zone's blend w * radial + (1 - w) * C(native label), a = b = n, C the tie
+    configuration of a labelled pair (the same for every tip), float64 domain weights: the smallest
+    signed area over tips, pairs, real factors F (step --fold-step from 1.05) and w in 0..1.
+
+    python bench/sd2_tie_limits.py [--max-n 15] [--max-m 15] [--max-f 15] [--fold-step 0.1]
 """
 from __future__ import annotations
 
@@ -26,7 +30,7 @@ import argparse
 
 import numpy as np
 
-from cltess.patterns.fractional import locations, to_fixed
+from cltess.patterns.fractional import locations, odd_segments, to_fixed
 
 
 def fan_triangles(n: int):
@@ -146,10 +150,41 @@ def birth_mismatches(m: int) -> dict:
     return {"points": total, "tips c, c+1 differ": wall, "a limit outside the triangle": outside}
 
 
+def blend_min_area(factor: float, pair: tuple, c: int, steps: int = 21) -> tuple[float, float]:
+    """(smallest signed area, its w) of fan c's zone blend towards the labelled tie configuration
+    ``pair`` through the native map, at real factor ``factor`` on all three edges."""
+    fixed = int(to_fixed(factor))
+    x, n = locations(fixed).astype(np.float64), odd_segments(fixed)
+    third = 3 - pair[0] - pair[1]
+
+    def grid_point(label):
+        w = np.zeros(3)
+        w[pair[0]], w[pair[1]] = x[label[pair[0]]], x[label[pair[1]]]
+        w[third] = 1.0 - w[pair[0]] - w[pair[1]]
+        return w
+
+    def radial_point(i, j):
+        w = np.zeros(3)
+        w[c], w[(c + 1) % 3], w[(c + 2) % 3] = 1.0 - x[i], x[i] * (1.0 - x[j]), x[i] * x[j]
+        return w
+
+    verts = {(i, j): (radial_point(i, j), grid_point(native_label(c, n, i, j)))
+             for i in range(n + 1) for j in range(n + 1)}
+    best = (np.inf, 0.0)
+    for w in np.linspace(0.0, 1.0, steps):
+        for tri in fan_triangles(n):
+            p = [w * verts[v][0] + (1.0 - w) * verts[v][1] for v in tri]
+            area = (p[1][1] - p[0][1]) * (p[2][2] - p[0][2]) - (p[1][2] - p[0][2]) * (p[2][1] - p[0][1])
+            best = min(best, (float(area), float(w)))
+    return best
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--max-n", type=int, default=15)
     parser.add_argument("--max-m", type=int, default=15)
+    parser.add_argument("--max-f", type=float, default=15.0)
+    parser.add_argument("--fold-step", type=float, default=0.1)
     args = parser.parse_args(argv)
     print("(A) fan c onto the grid lattice, labels only (any grid positions)")
     for name, label in (("native, partner c+1", native_label), ("partner c+2, no centres", flipped_label)):
@@ -160,6 +195,12 @@ def main(argv=None) -> int:
     print("(B) births at odd m (F -> m+): lattice points of n = m + 2 whose product limits differ")
     for m in range(1, args.max_m + 1, 2):
         print(f"  m = {m}: {birth_mismatches(m)}")
+    print("(C) zone blend radial -> C (native map), smallest signed area (negative: fold-over)")
+    factors = np.arange(1.05, args.max_f, args.fold_step)
+    for pair in ((0, 1), (1, 2), (2, 0)):
+        for c in range(3):
+            area, w, factor = min(blend_min_area(f, pair, c) + (float(f),) for f in factors)
+            print(f"  C = tie of corners {pair}, tip {c}: {area:.3g} (F = {factor:.2f}, w = {w:.2f})")
     return 0
 
 

@@ -4,7 +4,7 @@ labels only (so for any positions of the grid's points); the partner-c+2 map nee
 diagonal; and at every odd m the product limits of two tips' maps differ (the birth obstruction)."""
 import pytest
 
-from bench.sd2_tie_limits import birth_mismatches, check_collapse, flipped_label, native_label
+from bench.sd2_tie_limits import blend_min_area, birth_mismatches, check_collapse, flipped_label, native_label
 
 
 @pytest.mark.parametrize("n", range(1, 12))
@@ -23,3 +23,10 @@ def test_the_partner_c2_map_needs_the_other_diagonal(n):
 def test_product_limits_of_two_tips_differ_at_every_birth(m):
     counts = birth_mismatches(m)["tips c, c+1 differ"]
     assert all(v > 0 for v in counts.values())
+
+
+@pytest.mark.parametrize("factor", [1.3, 2.0, 2.86, 4.5, 6.2])
+@pytest.mark.parametrize("c", range(3))
+def test_the_native_blend_towards_one_labelled_configuration_does_not_fold(c, factor):
+    area, _ = blend_min_area(factor, (0, 1), c)
+    assert area >= -1e-12
