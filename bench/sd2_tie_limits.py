@@ -22,11 +22,20 @@ forbid, checked combinatorially on the SD-2 fan (NumPy only, no device).
     configuration of a labelled pair (the same for every tip), float64 domain weights: the smallest
     signed area over tips, pairs, real factors F (step --fold-step from 1.05) and w in 0..1.
 
+(D) The plateau of 1, exhaustively (n = 3, F -> 1+).  Every assignment of the fan's 4 interior
+    vertices (tip 0, a = b = 3, no centres) to the 10 lattice labels that collapses it onto the grid;
+    and, at the base's birth (G -> 1+, the fan with b = 1 has no interior vertex), every assignment
+    to the b = 1 fan's 7 vertices that collapses onto that fan.  As F -> 1+ each ring label tends to
+    a corner and the grid's centre (1,1,1) to some corner k; a vertex that must go from near one
+    corner to near another while F - 1 -> 0 crosses the patch (by about the error at factor 1).
+    Printed: for each k, how many wall collapses keep every vertex at its birth corner.
+
     python bench/sd2_tie_limits.py [--max-n 15] [--max-m 15] [--max-f 15] [--fold-step 0.1]
 """
 from __future__ import annotations
 
 import argparse
+import itertools
 
 import numpy as np
 
@@ -179,6 +188,62 @@ def blend_min_area(factor: float, pair: tuple, c: int, steps: int = 21) -> tuple
     return best
 
 
+def _collapses(positions: dict, ring: dict, area, allowed_edges, target) -> bool:
+    """Whether the fan of a = b = 3 with its interior vertices at `positions` (the rest at `ring`)
+    is the triangulation `target` plus triangles with two equal vertices on an allowed edge."""
+    hit = {}
+    for tri in fan_triangles(3):
+        lab = tuple(positions[v] if v in positions else ring[v] for v in tri)
+        distinct = set(lab)
+        if len(distinct) == 3:
+            if area(lab) <= 0 or _norm(lab) not in target:
+                return False
+            hit[_norm(lab)] = hit.get(_norm(lab), 0) + 1
+        elif len(distinct) == 2 and frozenset(distinct) not in allowed_edges:
+            return False
+    return set(hit) == target and all(v == 1 for v in hit.values())
+
+
+def plateau_of_one() -> dict:
+    """(D): {k: wall collapses of fan tip 0 that keep every interior vertex at its birth corner when
+    the grid's centre tends to corner k}, with the counts of wall and birth collapses."""
+    inner = [(1, 1), (1, 2), (2, 1), (2, 2)]
+    n = 3
+    # the wall: the n = 3 lattice (labels), fan vertices outside `inner` on their ring labels
+    labels = [(i0, i1, n - i0 - i1) for i0 in range(n + 1) for i1 in range(n + 1 - i0)]
+    grid = grid_triangles(n)
+    ring_labels = {(i, j): native_label(0, n, i, j) for i in range(n + 1) for j in range(n + 1)}
+    lattice_edges = {frozenset((p, q)) for p in labels for q in labels
+                     if sum(abs(a - b) for a, b in zip(p, q)) == 2}
+    walls = [dict(zip(inner, ch)) for ch in itertools.product(labels, repeat=4)
+             if _collapses(dict(zip(inner, ch)), ring_labels, lambda t: _orient(t, n), lattice_edges, grid)]
+    # the birth: G = 1+, base points 1, 2 on corners 1, 2; F = 1.5 (X(1) = 1/12) for the areas
+    x1, x2 = 1.0 / 12.0, 11.0 / 12.0
+    where = {"c0": (0, 0), "r1": (x1, 0), "r2": (x2, 0), "c1": (1, 0), "r1'": (0, x1), "r2'": (0, x2), "c2": (0, 1)}
+    corner_of = {"c0": 0, "r1": 0, "r1'": 0, "r2": 1, "c1": 1, "r2'": 2, "c2": 2}
+    ring = {(0, j): "c0" for j in range(4)}
+    ring.update({(1, 0): "r1", (2, 0): "r2", (3, 0): "c1", (3, 1): "c1", (3, 2): "c2", (3, 3): "c2",
+                 (1, 3): "r1'", (2, 3): "r2'"})
+    strip = ["c0", "r1", "r1'", "r2", "r2'", "c1", "c2"]
+    coarse = [(strip[k + 1], strip[k], strip[k + 2]) if k % 2 else tuple(strip[k:k + 3]) for k in range(5)]
+
+    def area(t):
+        (ax, ay), (bx, by), (cx, cy) = (where[v] for v in t)
+        return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+
+    coarse_edges = {frozenset(e) for t in coarse for e in ((t[0], t[1]), (t[1], t[2]), (t[0], t[2]))}
+    births = [dict(zip(inner, ch)) for ch in itertools.product(where, repeat=4)
+              if _collapses(dict(zip(inner, ch)), ring, area, coarse_edges, {_norm(t) for t in coarse})]
+
+    def corner(label, k):
+        return k if label == (1, 1, 1) else max(range(3), key=lambda q: label[q])
+
+    keep = {k: sum(1 for w in walls if any(all(corner(w[v], k) == corner_of[b[v]] for v in inner) for b in births))
+            for k in range(3)}
+    return {"wall collapses": len(walls), "birth collapses": len(births),
+            "vertex (2,2) at birth": sorted({b[(2, 2)] for b in births}), "kept, by centre corner k": keep}
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--max-n", type=int, default=15)
@@ -201,6 +266,8 @@ def main(argv=None) -> int:
         for c in range(3):
             area, w, factor = min(blend_min_area(f, pair, c) + (float(f),) for f in factors)
             print(f"  C = tie of corners {pair}, tip {c}: {area:.3g} (F = {factor:.2f}, w = {w:.2f})")
+    print("(D) the plateau of 1, fan tip 0 without centres, n = 3 as F -> 1+ and its birth at G -> 1+")
+    print(f"  {plateau_of_one()}")
     return 0
 
 

@@ -4,7 +4,7 @@ labels only (so for any positions of the grid's points); the partner-c+2 map nee
 diagonal; and at every odd m the product limits of two tips' maps differ (the birth obstruction)."""
 import pytest
 
-from bench.sd2_tie_limits import blend_min_area, birth_mismatches, check_collapse, flipped_label, native_label
+from bench.sd2_tie_limits import plateau_of_one, blend_min_area, birth_mismatches, check_collapse, flipped_label, native_label
 
 
 @pytest.mark.parametrize("n", range(1, 12))
@@ -30,3 +30,9 @@ def test_product_limits_of_two_tips_differ_at_every_birth(m):
 def test_the_native_blend_towards_one_labelled_configuration_does_not_fold(c, factor):
     area, _ = blend_min_area(factor, (0, 1), c)
     assert area >= -1e-12
+
+
+def test_near_factor_1_the_plain_fan_needs_the_grid_centre_at_its_corner_c_plus_2():
+    result = plateau_of_one()
+    assert result["wall collapses"] == 1 and result["vertex (2,2) at birth"] == ["r2'"]
+    assert result["kept, by centre corner k"] == {0: 0, 1: 0, 2: 1}
