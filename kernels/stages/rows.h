@@ -5,6 +5,19 @@
 #ifndef CLTESS_STAGES_ROWS_H
 #define CLTESS_STAGES_ROWS_H
 
+#ifndef STAGE4_RELOAD
+#define STAGE4_RELOAD 0
+#endif
+#ifndef STAGE4_GALLOP
+#define STAGE4_GALLOP 0
+#endif
+#ifndef STAGE4_SKIP_RING
+#define STAGE4_SKIP_RING 0
+#endif
+#ifndef STAGE4_SKIP_ROWS
+#define STAGE4_SKIP_ROWS 0
+#endif
+
 /* Ring point k of edge e: its domain point *x and its position, placed canonically on its edge
  * by the kind (kind_boundary_point: bitwise the neighbour's); a collapsed edge's points are all
  * its first corner.  Its normal is kind_eval's at *x. */
@@ -88,6 +101,14 @@ ALWAYS_INLINE void put_point(__private const kind_patch *patch, int4 f, int coll
             v -= ring_count;
         }
     }
+#if STAGE4_SKIP_RING  /* a measurement only (bench/gpu_stage45.py): not the engine's output */
+    if (on_ring)
+        return;
+#endif
+#if STAGE4_SKIP_ROWS
+    if (!on_ring)
+        return;
+#endif
     if (on_ring) {
         kind_eval(patch, x, 0, &normal);
         put_vertex(out, at, position, normal, x.xy, p, object);
@@ -138,16 +159,26 @@ ALWAYS_INLINE void put_points(__global const float4 *controls, uint patch_base, 
     kind_patch patch;
     for (uint k = 0; k < per_item && at < end; ++k, at += group) {
         if (at >= patch_end) {
+#if STAGE4_GALLOP
+            p = patch_after(vertex_offsets, p, last, at);  /* the next patches first, then halving */
+#else
             p = patch_of(vertex_offsets, p, last, at);  /* a binary search from the last patch on */
+#endif
             patch_start = vertex_offsets[p];
             patch_end = vertex_offsets[p + 1];
             f = patch_factors(factors[p], &collapsed);
             object = patch_objects[p];
-            if (from_prepared)
-                patch = prepared[p - first_patch];
-            else
+            if (!from_prepared)
                 kind_load(controls, p - patch_base, &patch);
+#if !STAGE4_RELOAD
+            else
+                patch = prepared[p - first_patch];
+#endif
         }
+#if STAGE4_RELOAD
+        if (from_prepared)  /* copied for this vertex alone: no patch held across the steps */
+            patch = prepared[p - first_patch];
+#endif
         put_point(&patch, f, collapsed, (uint)(at - patch_start), forward_differencing, out, at - vertex_base,
                   p, object);
     }
