@@ -20,7 +20,8 @@ Uniform level 16 (``frame_loop.teapots``: 1,000 teapots, 32,000 patches, every e
   value), e.g. ``opt:-DSTAGE4_RELOAD=1`` to pick a kernel variant.
   A ``Session`` frame first (builds, uploads; its output hashed: "same bits" compares the
   variants with the same evaluation), then ``--repeat`` frames: median device ms of each
-  stage (profiling spans) and of stages 1-5; % of fill = 565 MB / stages 1-5 / the fill rate.
+  stage (profiling spans) and of stages 1-5 (a label starting "diag": a measurement-only
+  variant, left out of "same bits"); % of fill = 565 MB / stages 1-5 / the fill rate.
   With NVIDIA's compiler, each variant's stage 4-5 kernels are built again with
   ``-cl-nv-verbose``: registers and spill bytes per kernel; ``--ptx DIR`` keeps their PTX.
 """
@@ -89,13 +90,13 @@ def child(args) -> dict:
             for name, regs in re.findall(r"Function properties for (\w+)[\s\S]*?Used (\d+) registers", log):
                 record["registers"][name] = int(regs)
             for name, stack, stored, loaded in re.findall(
-                    r"Function properties for (\w+)\s*\n\s*(\d+) bytes stack frame, (\d+) bytes spill stores, "
+                    r"Function properties for (\w+)\s*\n[^\n]*?(\d+) bytes stack frame, (\d+) bytes spill stores, "
                     r"(\d+) bytes spill loads", log):
                 record.setdefault("spills", {})[name] = [int(stack), int(stored), int(loaded)]
             record.setdefault("logs", {})[stage] = log[-3000:]
             if args.ptx:
                 Path(args.ptx).mkdir(parents=True, exist_ok=True)
-                (Path(args.ptx) / f"{args.label}-{stage}.ptx").write_bytes(program.binaries[0])
+                (Path(args.ptx) / f"{args.label.replace('/', '_')}-{stage}.ptx").write_bytes(program.binaries[0])
     return record
 
 
@@ -214,7 +215,9 @@ def main(argv=None) -> int:
             lines.append(f"| {row['label']} | {row['work']} | {row['tree']} | {row['options']} | failed |")
             continue
         direct = row["work"].endswith(":direct")
-        peers = {r["digest"] for r in record["variants"] if not r.get("failed") and r["work"].endswith(":direct") == direct}
+        peers = {r["digest"] for r in record["variants"] if not r.get("failed") and r["work"].endswith(":direct") == direct
+                 and not r["label"].startswith("diag")}
+        same = "(diagnostic)" if row["label"].startswith("diag") else "yes" if len(peers) == 1 else "NO"
         s = row["stage_ms"]
         s45 = s["vertices"] + s["indices"]
         regs = ", ".join(f"{k} {v}" for k, v in row.get("registers", {}).items() if k != "kind_patch_size")
@@ -222,7 +225,7 @@ def main(argv=None) -> int:
                      f"{s['counts']:.3f} | {s['vertices']:.3f} ({row['stage4_spread'][0]:.3f}-"
                      f"{row['stage4_spread'][1]:.3f}) | {s['indices']:.3f} | {s45:.3f} | "
                      f"{100 * row['bytes'] / (row['device_ms'] / 1e3) / fill:.1f}% | "
-                     f"{100 * row['bytes'] / (s45 / 1e3) / fill:.1f}% | {regs} | {'yes' if len(peers) == 1 else 'NO'} |")
+                     f"{100 * row['bytes'] / (s45 / 1e3) / fill:.1f}% | {regs} | {same} |")
     print("\n".join(lines))
     if args.json:
         Path(args.json).write_text(json.dumps(record, indent=1) + "\n")

@@ -285,20 +285,6 @@ inline uint patch_of(__global const ulong *offsets, uint lo, uint hi, ulong at)
     return lo;
 }
 
-/* As patch_of, for a search that moves forward from patch lo: lo + 1, lo + 2, lo + 4, ... are
- * tried until one lies past `at`, then the binary search between the last two tried (the same
- * patch: the last p with offsets[p] <= at).  A record of the next patch is found in two loads
- * instead of log2(hi - lo). */
-inline uint patch_after(__global const ulong *offsets, uint lo, uint hi, ulong at)
-{
-    uint step = 1;
-    while (hi - lo > step && offsets[lo + step] <= at) {
-        lo += step;
-        step <<= 1;
-    }
-    return patch_of(offsets, lo, min(hi, lo + step), at);
-}
-
 inline void load_patch(__global const float4 *patches, uint p, float4 b[16])
 {
     for (int k = 0; k < 16; ++k)

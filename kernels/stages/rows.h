@@ -5,19 +5,6 @@
 #ifndef CLTESS_STAGES_ROWS_H
 #define CLTESS_STAGES_ROWS_H
 
-#ifndef STAGE4_RELOAD
-#define STAGE4_RELOAD 0
-#endif
-#ifndef STAGE4_GALLOP
-#define STAGE4_GALLOP 0
-#endif
-#ifndef STAGE4_SKIP_RING
-#define STAGE4_SKIP_RING 0
-#endif
-#ifndef STAGE4_SKIP_ROWS
-#define STAGE4_SKIP_ROWS 0
-#endif
-
 /* Ring point k of edge e: its domain point *x and its position, placed canonically on its edge
  * by the kind (kind_boundary_point: bitwise the neighbour's); a collapsed edge's points are all
  * its first corner.  Its normal is kind_eval's at *x. */
@@ -101,14 +88,6 @@ ALWAYS_INLINE void put_point(__private const kind_patch *patch, int4 f, int coll
             v -= ring_count;
         }
     }
-#if STAGE4_SKIP_RING  /* a measurement only (bench/gpu_stage45.py): not the engine's output */
-    if (on_ring)
-        return;
-#endif
-#if STAGE4_SKIP_ROWS
-    if (!on_ring)
-        return;
-#endif
     if (on_ring) {
         kind_eval(patch, x, 0, &normal);
         put_vertex(out, at, position, normal, x.xy, p, object);
@@ -137,9 +116,13 @@ ALWAYS_INLINE void put_point(__private const kind_patch *patch, int4 f, int coll
 /* Stage 4 by vertex (stages/vertex_points.cl, prepared_points.cl): a work-group of G work-items
  * owns G * per_item consecutive vertices of the batch (patches first_patch .. first_patch +
  * num_patches - 1), and in step k its work-item l writes vertex k G + l of them, so each step's
- * stores are side by side.  A work-item finds (patch_of) and loads a patch only when its next
- * vertex is in another one: from prepared[p - first_patch] when from_prepared (a literal, so each kernel
- * keeps one of the two; no arithmetic), else by kind_load from controls.  Work-items past the
+ * stores are side by side.  A work-item finds its patch (patch_of) only when its next vertex is
+ * in another one.  Without from_prepared (a literal, so each kernel keeps one of the two) it then
+ * makes the patch by kind_load from controls and keeps it; with it, it copies the patch from
+ * prepared[p - first_patch] for each vertex (no arithmetic, cached: the lanes of a warp mostly
+ * read the same patch), so no kind_patch is live across the steps: on the H100 that took
+ * prepared_points from 232 to 162 registers and stage 4 of uniform level 16 from 1.32 to 1.14 ms
+ * (bench/RESULTS.md, "Issue 15: GPU stages 4-5, session 5").  Work-items past the
  * batch's last vertex stop; a batch of more than `capacity` vertices writes none (batch_fits). */
 ALWAYS_INLINE void put_points(__global const float4 *controls, uint patch_base, const int from_prepared,
                               __global const kind_patch *prepared, __global const int4 *factors,
@@ -159,26 +142,16 @@ ALWAYS_INLINE void put_points(__global const float4 *controls, uint patch_base, 
     kind_patch patch;
     for (uint k = 0; k < per_item && at < end; ++k, at += group) {
         if (at >= patch_end) {
-#if STAGE4_GALLOP
-            p = patch_after(vertex_offsets, p, last, at);  /* the next patches first, then halving */
-#else
             p = patch_of(vertex_offsets, p, last, at);  /* a binary search from the last patch on */
-#endif
             patch_start = vertex_offsets[p];
             patch_end = vertex_offsets[p + 1];
             f = patch_factors(factors[p], &collapsed);
             object = patch_objects[p];
             if (!from_prepared)
                 kind_load(controls, p - patch_base, &patch);
-#if !STAGE4_RELOAD
-            else
-                patch = prepared[p - first_patch];
-#endif
         }
-#if STAGE4_RELOAD
-        if (from_prepared)  /* copied for this vertex alone: no patch held across the steps */
+        if (from_prepared)  /* copied for this vertex alone: no patch held in registers across the steps */
             patch = prepared[p - first_patch];
-#endif
         put_point(&patch, f, collapsed, (uint)(at - patch_start), forward_differencing, out, at - vertex_base,
                   p, object);
     }

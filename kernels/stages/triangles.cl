@@ -12,10 +12,6 @@
  * "Stage 5 by triangle").
  * The batch is patches first_patch .. first_patch + num_patches - 1; work-items past its last
  * triangle stop. */
-#ifndef STAGE5_GALLOP
-#define STAGE5_GALLOP 0
-#endif
-
 __kernel void triangles(__global const int4 *factors, __global const ulong *vertex_offsets,
                         __global const ulong *index_offsets, uint first_patch, uint num_patches,
                         ulong index_base, ulong capacity, uint per_item, __global uint *indices)
@@ -31,11 +27,7 @@ __kernel void triangles(__global const int4 *factors, __global const ulong *vert
     int collapsed = 0;
     for (uint k = 0; k < per_item && at < end; ++k, at += group) {
         if (at >= patch_end) {
-#if STAGE5_GALLOP
-            p = patch_after(index_offsets, p, last, 3 * at);
-#else
             p = patch_of(index_offsets, p, last, 3 * at);
-#endif
             patch_start = index_offsets[p] / 3;
             patch_end = index_offsets[p + 1] / 3;
             f = patch_factors(factors[p], &collapsed);
