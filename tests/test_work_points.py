@@ -91,13 +91,15 @@ def by_prepared_points(tessellator):
     return opencl.Tessellator(tessellator.device, work="point-prep")
 
 
-@pytest.mark.parametrize("records_per_item", [1, opencl.RECORDS_PER_ITEM])
+@pytest.mark.parametrize("records_per_item", [1, opencl.RECORDS_PER_ITEM, opencl.RECORDS_PER_ITEM_PREPARED])
 @pytest.mark.parametrize("name, options", CASES)
 def test_prepared_points_are_bitwise_the_per_patch_kernels(tessellator, by_prepared_points, monkeypatch, name,
                                                            options, records_per_item):
-    """The kind_patch made once per patch (prepare_patches) and copied: the same bits as kind_load
-    at every patch change, forward differencing and direct, every kind and pattern."""
+    """The kind_patch made once per patch (prepare_patches) and copied for each vertex: the same
+    bits as kind_load at every patch change, forward differencing and direct, every kind and
+    pattern, at 1, 4 and 16 records per work-item."""
     monkeypatch.setattr(opencl, "RECORDS_PER_ITEM", records_per_item)
+    monkeypatch.setattr(opencl, "RECORDS_PER_ITEM_PREPARED", records_per_item)
     scene = load_scene(SCENES / name)
     per_patch = opencl.Tessellator(tessellator.device, work="patch")
     expected, got = per_patch.tessellate(scene, **options), by_prepared_points.tessellate(scene, **options)

@@ -116,9 +116,13 @@ ALWAYS_INLINE void put_point(__private const kind_patch *patch, int4 f, int coll
 /* Stage 4 by vertex (stages/vertex_points.cl, prepared_points.cl): a work-group of G work-items
  * owns G * per_item consecutive vertices of the batch (patches first_patch .. first_patch +
  * num_patches - 1), and in step k its work-item l writes vertex k G + l of them, so each step's
- * stores are side by side.  A work-item finds (patch_of) and loads a patch only when its next
- * vertex is in another one: from prepared[p - first_patch] when from_prepared (a literal, so each kernel
- * keeps one of the two; no arithmetic), else by kind_load from controls.  Work-items past the
+ * stores are side by side.  A work-item finds its patch (patch_of) only when its next vertex is
+ * in another one.  Without from_prepared (a literal, so each kernel keeps one of the two) it then
+ * makes the patch by kind_load from controls and keeps it; with it, it copies the patch from
+ * prepared[p - first_patch] for each vertex (no arithmetic, cached: the lanes of a warp mostly
+ * read the same patch), so no kind_patch is live across the steps: on the H100 that took
+ * prepared_points from 232 to 162 registers and stage 4 of uniform level 16 from 1.32 to 1.14 ms
+ * (bench/RESULTS.md, "Issue 15: GPU stages 4-5, session 5").  Work-items past the
  * batch's last vertex stop; a batch of more than `capacity` vertices writes none (batch_fits). */
 ALWAYS_INLINE void put_points(__global const float4 *controls, uint patch_base, const int from_prepared,
                               __global const kind_patch *prepared, __global const int4 *factors,
@@ -143,11 +147,11 @@ ALWAYS_INLINE void put_points(__global const float4 *controls, uint patch_base, 
             patch_end = vertex_offsets[p + 1];
             f = patch_factors(factors[p], &collapsed);
             object = patch_objects[p];
-            if (from_prepared)
-                patch = prepared[p - first_patch];
-            else
+            if (!from_prepared)
                 kind_load(controls, p - patch_base, &patch);
         }
+        if (from_prepared)  /* copied for this vertex alone: no patch held in registers across the steps */
+            patch = prepared[p - first_patch];
         put_point(&patch, f, collapsed, (uint)(at - patch_start), forward_differencing, out, at - vertex_base,
                   p, object);
     }

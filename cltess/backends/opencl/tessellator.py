@@ -52,6 +52,13 @@ MAX_ROWS_PER_PATCH = 65
 #: WORK_GROUP work-items owns WORK_GROUP * this consecutive records, written side by side in
 #: steps; a patch is found and loaded once per work-item and patch, not per record).
 RECORDS_PER_ITEM = 4
+#: The same for "vertex-prep" and "point-prep" (stage 4 from prepared patches, and stage 5 with
+#: it): a distribution for scenes of large patches, where on the H100 16 records per work-item
+#: made stages 4 + 5 of uniform level 16 7% faster than 4 (1.29 against 1.39 ms; stage 5 0.217
+#: against 0.250: fewer patch searches per triangle; bench/RESULTS.md, "Issue 15: GPU stages
+#: 4-5, session 5"), and 1 slower (1.76).  "point" keeps RECORDS_PER_ITEM (the paper's scenes).
+RECORDS_PER_ITEM_PREPARED = 16
+PREPARED_WORK = ("vertex-prep", "point-prep")
 #: How stages 4-5 spread their work (docs/design.md, "Work distribution"): "patch" a work-item
 #: per patch (stages/vertices.cl, stages/indices.cl); "rows" stage 4 a work-item per (patch,
 #: row) (stages/vertex_rows.cl), stage 5 per patch; "vertex" stage 4 a work-item per output
@@ -209,9 +216,17 @@ class Tessellator:
 
     @property
     def per_item(self) -> int:
-        """Records per work-item of the record kernels: ``records_per_item`` if set, else
-        ``RECORDS_PER_ITEM`` (read at each launch)."""
-        return self.records_per_item or RECORDS_PER_ITEM
+        """Records per work-item of the record kernels under this Tessellator's ``work``
+        (``records_for``)."""
+        return self.records_for(self.work)
+
+    def records_for(self, work: str) -> int:
+        """Records per work-item of the record kernels under work distribution ``work``:
+        ``records_per_item`` if set, else ``RECORDS_PER_ITEM_PREPARED`` for the prepared
+        distributions and ``RECORDS_PER_ITEM`` otherwise (read at each launch)."""
+        if self.records_per_item:
+            return self.records_per_item
+        return RECORDS_PER_ITEM_PREPARED if work in PREPARED_WORK else RECORDS_PER_ITEM
 
     @property
     def rows_in_parallel(self) -> bool:
@@ -690,8 +705,8 @@ class Tessellator:
                                           forward_differencing, kind, patch_base, pattern, out)
         elif rows_per_patch is None and work in ("vertex", "point"):  # work-items past the part's vertices return
             event = self.programs.kernel("vertex_points", kind=kind, pattern=pattern)(
-                self.queue, _record_groups(vertex_range[1] - vertex_range[0], self.per_item), (WORK_GROUP,),
-                *arguments, np.uint32(self.per_item), *(a.data for a in out.values()))
+                self.queue, _record_groups(vertex_range[1] - vertex_range[0], self.records_for(work)), (WORK_GROUP,),
+                *arguments, np.uint32(self.records_for(work)), *(a.data for a in out.values()))
         elif rows_per_patch:
             event = self.programs.kernel("vertex_rows", kind=kind, pattern=pattern)(
                 self.queue, _global_size((last - first) * rows_per_patch), None, *arguments,
@@ -730,11 +745,12 @@ class Tessellator:
         prepare = self.programs.kernel("prepared_points", "prepare_patches", **program)(
             self.queue, _global_size(last - first), None, controls.data, vertex_offsets.data, np.uint32(first),
             np.uint32(last - first), np.uint32(patch_base), self._prepared)
+        per_item = self.records_for("point-prep")
         points = self.programs.kernel("prepared_points", **program)(
-            self.queue, _record_groups(vertex_range[1] - vertex_range[0], self.per_item), (WORK_GROUP,),
+            self.queue, _record_groups(vertex_range[1] - vertex_range[0], per_item), (WORK_GROUP,),
             self._prepared, factors.data, vertex_offsets.data, patch_objects.data, np.uint32(first),
             np.uint32(last - first), np.uint64(vertex_range[0]), np.int32(forward_differencing),
-            np.uint64(vertex_range[1] - vertex_range[0]), np.uint32(self.per_item), *(a.data for a in out.values()))
+            np.uint64(vertex_range[1] - vertex_range[0]), np.uint32(per_item), *(a.data for a in out.values()))
         return prepare, points
 
     def stage_indices(self, factors, vertex_offsets, index_offsets, index_range, patch_range,
@@ -752,10 +768,12 @@ class Tessellator:
             return triangles, []
         arguments = (factors.data, vertex_offsets.data, index_offsets.data, np.uint32(first),
                      np.uint32(last - first), np.uint64(index_range[0]), np.uint64(n))
-        if (work or self.work) in ("point", "point-prep"):  # work-items past the part's triangles stop
+        work = work or self.work
+        if work in ("point", "point-prep"):  # work-items past the part's triangles stop
+            per_item = self.records_for(work)
             event = self.programs.kernel("triangles", pattern=_pattern(kind))(
-                self.queue, _record_groups(n // 3, self.per_item), (WORK_GROUP,), *arguments,
-                np.uint32(self.per_item), triangles.data)
+                self.queue, _record_groups(n // 3, per_item), (WORK_GROUP,), *arguments,
+                np.uint32(per_item), triangles.data)
         else:
             event = self.programs.kernel("indices", pattern=_pattern(kind))(
                 self.queue, _global_size(last - first), None, *arguments, triangles.data)
