@@ -10,11 +10,19 @@
  * the earlier tiles, is offsets[p + 1].  The range starts from offsets[patch_base], which the
  * launch of the previous range wrote (the queue is in order) or which is 0 for the first; so
  * several ranges (kinds or patterns) need no host round trip.  Integer sums: the same offsets
- * as the scans. */
-__kernel void offsets(__global const int4 *factors, uint num_patches, uint patch_base,
-                      __global ulong *vertex_counts, __global ulong *index_counts,
-                      __global ulong *vertex_offsets, __global ulong *index_offsets,
-                      __local ulong *scan_v, __local ulong *scan_i)
+ * as the scans.
+ *
+ * offsets_summary (the last range of a frame, Tessellator.stage_counts with a summary): the same,
+ * then the frame's summary in one 32-byte buffer that the host reads once (issue 15: one read
+ * per frame instead of three): summary[0], [1] the vertex and index totals (offsets[P]),
+ * summary[2], [3] how many of flags[0 .. num_flags-1] (stage 1's, every patch of the scene) have
+ * FLAG_CULLED and FLAG_SATURATED. */
+/* The counts and offsets of one range; returns the offsets past its end (the totals, for the
+ * last range), the same in every work-item. */
+inline ulong2 offsets_of_range(__global const int4 *factors, uint num_patches, uint patch_base,
+                               __global ulong *vertex_counts, __global ulong *index_counts,
+                               __global ulong *vertex_offsets, __global ulong *index_offsets,
+                               __local ulong *scan_v, __local ulong *scan_i)
 {
     uint l = (uint)get_local_id(0), group = (uint)get_local_size(0);
     ulong carry_v = vertex_offsets[patch_base], carry_i = index_offsets[patch_base];
@@ -47,5 +55,48 @@ __kernel void offsets(__global const int4 *factors, uint num_patches, uint patch
         carry_v += scan_v[group - 1];
         carry_i += scan_i[group - 1];
         barrier(CLK_LOCAL_MEM_FENCE);  /* every work-item has read scan_* before the next tile */
+    }
+    return (ulong2)(carry_v, carry_i);
+}
+
+__kernel void offsets(__global const int4 *factors, uint num_patches, uint patch_base,
+                      __global ulong *vertex_counts, __global ulong *index_counts,
+                      __global ulong *vertex_offsets, __global ulong *index_offsets,
+                      __local ulong *scan_v, __local ulong *scan_i)
+{
+    offsets_of_range(factors, num_patches, patch_base, vertex_counts, index_counts, vertex_offsets,
+                     index_offsets, scan_v, scan_i);
+}
+
+__kernel void offsets_summary(__global const int4 *factors, uint num_patches, uint patch_base,
+                              __global ulong *vertex_counts, __global ulong *index_counts,
+                              __global ulong *vertex_offsets, __global ulong *index_offsets,
+                              __global const int *flags, uint num_flags, __global ulong *summary,
+                              __local ulong *scan_v, __local ulong *scan_i)
+{
+    ulong2 totals = offsets_of_range(factors, num_patches, patch_base, vertex_counts, index_counts,
+                                     vertex_offsets, index_offsets, scan_v, scan_i);
+    uint l = (uint)get_local_id(0), group = (uint)get_local_size(0);
+    ulong culled = 0, saturated = 0;
+    for (uint p = l; p < num_flags; p += group) {
+        int flag = flags[p];
+        culled += (flag & FLAG_CULLED) != 0;
+        saturated += (flag & FLAG_SATURATED) != 0;
+    }
+    scan_v[l] = culled;  /* (the range's last barrier: every work-item is done with scan_*) */
+    scan_i[l] = saturated;
+    barrier(CLK_LOCAL_MEM_FENCE);
+    for (uint step = group >> 1; step > 0; step >>= 1) {  /* a tree sum (group: a power of two) */
+        if (l < step) {
+            scan_v[l] += scan_v[l + step];
+            scan_i[l] += scan_i[l + step];
+        }
+        barrier(CLK_LOCAL_MEM_FENCE);
+    }
+    if (l == 0) {
+        summary[0] = totals.x;
+        summary[1] = totals.y;
+        summary[2] = scan_v[0];
+        summary[3] = scan_i[0];
     }
 }
