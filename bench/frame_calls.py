@@ -14,6 +14,9 @@ warm-up pass), then three loops over the cameras, counting the calls per frame:
 * "host arrays": ``session.tessellate(camera=...).fetch()``;
 * "overlapped": ``session.tessellate(camera=..., wait=False)``, the last frame finished.
 
+``--as-gpu`` makes the frames a GPU makes (work "point", stage 3 in one launch up to
+``FUSED_OFFSETS_MAX_PATCHES``) on this device, to count their calls here.
+
 The counts wrap pyopencl's entry points in this process (``pyopencl._cl.enqueue_nd_range_kernel``,
 ``_enqueue_read_buffer``, ``_enqueue_copy_buffer``, ``enqueue_map_buffer``, ``MemoryMap.release``,
 markers, ``CommandQueue.flush``, ``wait_for_events``, ``Event.wait``, event status and profiling
@@ -115,6 +118,9 @@ def main() -> int:
     parser.add_argument("--scenes", nargs="*", default=["tea_table", "double_torus", "killeroo", "spheres", "model_zoo"])
     parser.add_argument("--profile", type=int, default=0, metavar="N")
     parser.add_argument("--profile-rounds", type=int, default=5, help="loops over the cameras profiled")
+    parser.add_argument("--as-gpu", action="store_true",
+                        help="count the calls a GPU's frame makes (work 'point', stage 3 fused up to "
+                             "FUSED_OFFSETS_MAX_PATCHES) on this device; its times mean nothing")
     parser.add_argument("--json")
     args = parser.parse_args()
     import warnings
@@ -125,7 +131,9 @@ def main() -> int:
 
     if not args.profile:  # (the counting wrappers would show up in the profile)
         install()
-    tessellator = Tessellator(args.device)
+    tessellator = Tessellator(args.device, work="point" if args.as_gpu else None)
+    if args.as_gpu:
+        tessellator.fused_offsets, tessellator.tiled_offsets, tessellator._cpu = True, True, False
     overlaps = "wait" in inspect.signature(cltess.Session.tessellate).parameters
     print(f"{tessellator.device.name.strip()} ({tessellator.device.platform.name.strip()}); cltess from "
           f"{cltess.__file__}; calls per frame, mean over {args.frames} cameras")

@@ -127,10 +127,18 @@ class Session:
                 plan.settle()
             if plan.settled:
                 self.output.reserve(plan.num_vertices, plan.num_indices // 3)
-        plan = tessellator.plan_on(self._scene_data[key], request, started, self._scratch[key], defer_totals=True)
+        # The launches keep their arguments (the session's buffers): the next frame's launches
+        # with the same ones only enqueue (programs.Kernel).
+        programs = tessellator.programs
+        programs.keep_arguments = True
+        try:
+            plan = tessellator.plan_on(self._scene_data[key], request, started, self._scratch[key], defer_totals=True)
+            pending = tessellator.emit_async(plan, 0, plan.num_patches, out=self.output)
+        finally:
+            programs.keep_arguments = False
         self._plans = [*self._plans[-1:], plan]
         self.frames += 1
-        return tessellator.emit_async(plan, 0, plan.num_patches, out=self.output).result(on_device=True, wait=wait)
+        return pending.result(on_device=True, wait=wait)
 
     def __repr__(self) -> str:
         return (f"Session({self.scene.name!r}, {self.device.name.strip()!r}, {self.frames} frames, "

@@ -100,3 +100,113 @@ __kernel void offsets_summary(__global const int4 *factors, uint num_patches, ui
         summary[3] = scan_i[0];
     }
 }
+
+/* Stage 3 in two launches for many patches (Tessellator.stage_counts, tiled: a scene above the
+ * one-launch cap, where one work-group would be too slow; issue 15: two launches and no
+ * temporaries from the host, where the counts kernel and pyopencl.scan were four launches and two
+ * arrays made per frame).  offsets_tiles, a work-group per tile of G = get_local_size(0)
+ * consecutive patches of one range (launched per range; its tiles are tile_base, tile_base + 1,
+ * ...): the counts (stored), their inclusive scan within the tile as offsets[p + 1], and the
+ * tile's record in tiles[4 t ..]: vertex sum, index sum, flag counts (culled in the low 32 bits,
+ * saturated in the high: fewer than 2^32 patches), first patch | patch count << 32.
+ * offsets_carries, a work-group per tile: adds to the tile's offsets the sums of every earlier
+ * tile, and the last tile writes the summary as offsets_summary does.  Integer sums: the offsets
+ * of the scans. */
+__kernel void offsets_tiles(__global const int4 *factors, uint num_patches, uint patch_base, uint tile_base,
+                            __global const int *flags, __global ulong *vertex_counts,
+                            __global ulong *index_counts, __global ulong *vertex_offsets,
+                            __global ulong *index_offsets, __global ulong *tiles,
+                            __local ulong *scan_v, __local ulong *scan_i)
+{
+    uint l = (uint)get_local_id(0), group = (uint)get_local_size(0), tile = (uint)get_group_id(0);
+    uint first = tile * group, q = first + l, p = patch_base + q;
+    ulong v = 0, i = 0, f = 0;
+    if (q < num_patches) {
+        int collapsed, flag = flags[p];
+        int4 factor = patch_factors(factors[p], &collapsed);
+        v = pattern_vertex_count(factor);
+        i = 3 * (ulong)pattern_primitives(factor, collapsed, 0, 0);
+        vertex_counts[p] = v;
+        index_counts[p] = i;
+        f = (ulong)((flag & FLAG_CULLED) != 0) | ((ulong)((flag & FLAG_SATURATED) != 0) << 32);
+    }
+    scan_v[l] = v;
+    scan_i[l] = i;
+    barrier(CLK_LOCAL_MEM_FENCE);
+    for (uint d = 1; d < group; d <<= 1) {  /* Hillis-Steele, as offsets_of_range */
+        ulong add_v = l >= d ? scan_v[l - d] : 0, add_i = l >= d ? scan_i[l - d] : 0;
+        barrier(CLK_LOCAL_MEM_FENCE);
+        scan_v[l] += add_v;
+        scan_i[l] += add_i;
+        barrier(CLK_LOCAL_MEM_FENCE);
+    }
+    if (q < num_patches) {
+        vertex_offsets[p + 1] = scan_v[l];
+        index_offsets[p + 1] = scan_i[l];
+    }
+    ulong sum_v = scan_v[group - 1], sum_i = scan_i[group - 1];
+    barrier(CLK_LOCAL_MEM_FENCE);  /* every work-item has read scan_v before it holds the flags */
+    scan_v[l] = f;
+    barrier(CLK_LOCAL_MEM_FENCE);
+    for (uint step = group >> 1; step > 0; step >>= 1) {
+        if (l < step)
+            scan_v[l] += scan_v[l + step];
+        barrier(CLK_LOCAL_MEM_FENCE);
+    }
+    if (l == 0) {
+        __global ulong *record = tiles + 4 * (ulong)(tile_base + tile);
+        record[0] = sum_v;
+        record[1] = sum_i;
+        record[2] = scan_v[0];
+        record[3] = (ulong)(patch_base + first) | ((ulong)min(group, num_patches - first) << 32);
+    }
+}
+
+__kernel void offsets_carries(uint num_tiles, __global const ulong *tiles, __global ulong *vertex_offsets,
+                              __global ulong *index_offsets, __global ulong *summary,
+                              __local ulong *scan_v, __local ulong *scan_i)
+{
+    uint l = (uint)get_local_id(0), group = (uint)get_local_size(0), tile = (uint)get_group_id(0);
+    bool last = tile + 1 == num_tiles;
+    ulong carry_v = 0, carry_i = 0, flag_counts = 0;
+    for (uint t = l; t < tile; t += group) {  /* the earlier tiles' sums */
+        carry_v += tiles[4 * (ulong)t];
+        carry_i += tiles[4 * (ulong)t + 1];
+        flag_counts += tiles[4 * (ulong)t + 2];
+    }
+    scan_v[l] = carry_v;
+    scan_i[l] = carry_i;
+    barrier(CLK_LOCAL_MEM_FENCE);
+    for (uint step = group >> 1; step > 0; step >>= 1) {
+        if (l < step) {
+            scan_v[l] += scan_v[l + step];
+            scan_i[l] += scan_i[l + step];
+        }
+        barrier(CLK_LOCAL_MEM_FENCE);
+    }
+    carry_v = scan_v[0];
+    carry_i = scan_i[0];
+    ulong span = tiles[4 * (ulong)tile + 3];
+    uint first = (uint)span, count = (uint)(span >> 32);
+    for (uint q = l; q < count; q += group) {
+        vertex_offsets[first + q + 1] += carry_v;
+        index_offsets[first + q + 1] += carry_i;
+    }
+    if (last) {  /* (uniform across the work-group: its barriers are reached by all or none) */
+        barrier(CLK_LOCAL_MEM_FENCE);  /* every work-item has read the carries */
+        scan_v[l] = flag_counts;
+        barrier(CLK_LOCAL_MEM_FENCE);
+        for (uint step = group >> 1; step > 0; step >>= 1) {
+            if (l < step)
+                scan_v[l] += scan_v[l + step];
+            barrier(CLK_LOCAL_MEM_FENCE);
+        }
+        if (l == 0) {
+            ulong flags_all = scan_v[0] + tiles[4 * (ulong)tile + 2];
+            summary[0] = carry_v + tiles[4 * (ulong)tile];
+            summary[1] = carry_i + tiles[4 * (ulong)tile + 1];
+            summary[2] = flags_all & 0xffffffffUL;
+            summary[3] = flags_all >> 32;
+        }
+    }
+}

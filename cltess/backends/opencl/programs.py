@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pyopencl as cl
+import pyopencl._cl as _cl
 from pyopencl.scan import GenericScanKernel
 from pyopencl.tools import get_or_register_dtype, match_dtype_to_c_struct
 
@@ -83,19 +84,31 @@ class Kernel:
     scalar keep the generic path.  Every call site passes a kernel parameter the same NumPy
     type each time (the kernel's C type); a later value of another type is packed as the first
     call's type, or refused by ``struct`` (out of range, wrong kind), never reinterpreted.
+    A launch made while ``Programs.keep_arguments`` is on (a ``Session`` frame) keeps its
+    arguments; the next launch with equal arguments (the same buffers, equal scalars: stages 2-5
+    of frame after frame) enqueues the kernel alone, without setting them again (issue 15: a
+    frame's host cost).  Any other launch forgets them, so that no buffer outlives its
+    caller for the sake of this.
     Anything else (``get_work_group_info``, ``function_name``) is the pyopencl kernel's."""
 
-    __slots__ = ("kernel", "arg_types")
+    __slots__ = ("kernel", "arg_types", "programs", "kept")
 
-    def __init__(self, kernel: cl.Kernel):
+    def __init__(self, kernel: cl.Kernel, programs: "Programs | None" = None):
         self.kernel = kernel
         self.arg_types = None
+        self.programs = programs
+        self.kept = None  # the last launch's arguments, still set on the kernel (Programs.keep_arguments)
 
     def __call__(self, queue, global_size, local_size, *args, **options) -> cl.Event:
+        if args == self.kept and not options:  # set by the last launch and unchanged: enqueue alone
+            return _cl.enqueue_nd_range_kernel(queue, self.kernel, global_size, local_size, None, None, False, False)
         if self.arg_types is None:
             self.arg_types = tuple(a.dtype if isinstance(a, np.generic) else None for a in args)
             self.kernel.set_arg_types(self.arg_types)
-        return self.kernel(queue, global_size, local_size, *args, **options)
+        event = self.kernel(queue, global_size, local_size, *args, **options)
+        keep = self.programs is not None and self.programs.keep_arguments and not options
+        self.kept = args if keep else None
+        return event
 
     def __getattr__(self, name):
         return getattr(self.kernel, name)
@@ -159,6 +172,9 @@ class Programs:
         self._programs: dict = {}
         self._kernels: dict = {}
         self._seen: dict = {}  # Programs.kernel's look-up by the identity of its arguments
+        #: Whether launches keep their arguments for the next (``Kernel``): on while a Session
+        #: enqueues a frame, whose buffers live with the session.
+        self.keep_arguments = False
         self.offsets_scan = GenericScanKernel(
             context, np.uint64, arguments="__global const ulong *counts, __global ulong *offsets",
             input_expr="counts[i]", scan_expr="a+b", neutral="0",
@@ -223,7 +239,7 @@ class Programs:
         if key not in self._programs:
             self._programs[key] = self.build(stage, headers, defines)
         if (key, entry) not in self._kernels:  # one Kernel object each: pyopencl caches its call set-up
-            self._kernels[key, entry] = Kernel(getattr(self._programs[key], entry or stage))
+            self._kernels[key, entry] = Kernel(getattr(self._programs[key], entry or stage), self)
         return self._kernels[key, entry]
 
     def compose(self, kind, pattern, tolerance, work: str = "patch") -> None:

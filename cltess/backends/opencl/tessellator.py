@@ -85,6 +85,14 @@ FUSED_OFFSETS_MAX_PATCHES = 1 << 14
 FUSED_OFFSETS_MAX_PATCHES_CPU = 1 << 11
 #: The fused launch's work-group size at most (a power of two; less where the device says so).
 FUSED_OFFSETS_GROUP = 1024
+#: Stage 3 in two launches (stages/offsets.cl offsets_tiles, offsets_carries) above the one-launch
+#: cap and up to this many patches, where a frame asks for its summary: the counts kernel and
+#: pyopencl.scan cost four launches and ~100 µs of host Python per frame (two temporary arrays;
+#: bench/RESULTS.md, "Issue 15: a frame's host cost, session 5").  The carries kernel reads every
+#: earlier tile's record per tile (quadratic in the tiles), so more patches keep the scan.
+TILED_OFFSETS_MAX_PATCHES = 1 << 18
+#: Patches per tile of the two-launch stage 3 (a power of two; less where the device says so).
+TILED_OFFSETS_GROUP = 256
 #: A frame's summary, written by stage 3 and read back in one copy (``Tessellator.stage_counts``):
 #: vertex total, index total, patches culled, patches saturated (uint64 each).
 SUMMARY_FIELDS = 4
@@ -114,6 +122,21 @@ def default_fused_offsets(device: cl.Device) -> bool:
     if chosen:
         return chosen == "1"
     return bool(device.type & cl.device_type.GPU) != bool(device.type & cl.device_type.CPU)
+
+
+def default_tiled_offsets(device: cl.Device) -> bool:
+    """Stage 3 in two launches where a plan asks for its summary and one launch would be too slow
+    (``TILED_OFFSETS_MAX_PATCHES``): ``CLTESS_TILED_OFFSETS`` (0 or 1) if set, else on GPUs only.
+    On CPUs (Intel's runtime, 2 vCPUs) its tiles' scans in local memory took twice the device
+    time of the counts kernel and pyopencl.scan (killeroo 1.3-1.6 against 0.7-0.9 ms, spheres 3.7
+    against 2.0, model zoo 8.5 against 4.0; bench/RESULTS.md, "Issue 15: a frame's host cost,
+    session 5").  Not on a device that says it is both (Oclgrind: "all")."""
+    chosen = os.environ.get("CLTESS_TILED_OFFSETS")
+    if chosen not in (None, "", "0", "1"):
+        raise ValueError(f"CLTESS_TILED_OFFSETS={chosen!r}: expected 0 or 1")
+    if chosen:
+        return chosen == "1"
+    return bool(device.type & cl.device_type.GPU) and not device.type & cl.device_type.CPU
 
 
 def pure_cpu(device: cl.Device) -> bool:
@@ -209,7 +232,8 @@ class Tessellator:
         self.fused_offsets = default_fused_offsets(self.device)  # stage 3 by stages/offsets.cl
         self._cpu = pure_cpu(self.device)  # stage 3 fused up to FUSED_OFFSETS_MAX_PATCHES_CPU only
         self._kind_patch_sizes: dict = {}
-        self._fused_groups: dict = {}  # (stage 3's fused kernel, group cap) -> (work-group size, local arrays)
+        self._fused_groups: dict = {}  # (a stage 3 kernel, group cap) -> (work-group size, local arrays): _group_of
+        self.tiled_offsets = default_tiled_offsets(self.device)  # stage 3 in two launches above the fused cap
 
     @property
     def per_item(self) -> int:
@@ -275,6 +299,9 @@ class Tessellator:
                 if self.fused_offsets:
                     self.programs.kernel("offsets", pattern=pattern)
                     self.programs.kernel("offsets", "offsets_summary", pattern=pattern)
+                if self.tiled_offsets:
+                    self.programs.kernel("offsets", "offsets_tiles", pattern=pattern)
+                    self.programs.kernel("offsets", "offsets_carries", pattern=pattern)
                 if self.work.endswith("-prep"):  # before the plan's buffers (prepared_scratch)
                     self.prepared_scratch(kind, pattern, kind.count(scene))
                 if pattern.fixed_point:  # SD-2's level functions
@@ -646,6 +673,8 @@ class Tessellator:
         vertex_offsets, index_offsets = scratch["vertex_offsets"], scratch["index_offsets"]
         if summary is not None and not self.writes_summary(count, ranges):
             raise ValueError("stage 3 writes a summary in one launch or with one scan (CLTESS_ONE_SCAN=1)")
+        if summary is not None and self._tiled(count, ranges):  # two launches: tiles, then their carries
+            return vertex_offsets, index_offsets, self._tiled_offsets(ranges, factors, flags, summary, scratch)
         if self._fused(count, ranges):  # one launch per range, in order; the last one writes the summary
             ranges = [r for r in sorted(ranges, key=lambda r: r[1]) if r[2]]
             events = [self._fused_offsets(_pattern(k), factors, base, n, vertex_counts, index_counts,
@@ -675,10 +704,57 @@ class Tessellator:
         cap = min(FUSED_OFFSETS_MAX_PATCHES, FUSED_OFFSETS_MAX_PATCHES_CPU) if self._cpu else FUSED_OFFSETS_MAX_PATCHES
         return self.fused_offsets and count <= cap and not any(_pattern(k).counts_walk for k, _, n in ranges if n)
 
+    def _tiled(self, count: int, ranges) -> bool:
+        """Whether stage 3 with a summary is two launches (``_tiled_offsets``): ``tiled_offsets``,
+        not one launch (``_fused``), up to ``TILED_OFFSETS_MAX_PATCHES``, no pattern whose counts
+        walk it."""
+        return (self.tiled_offsets and count <= TILED_OFFSETS_MAX_PATCHES and not self._fused(count, ranges)
+                and not any(_pattern(k).counts_walk for k, _, n in ranges if n))
+
+    def _tiled_offsets(self, ranges, factors, flags, summary, scratch: dict) -> list:
+        """Stage 3 in two launches (stages/offsets.cl offsets_tiles per range, then
+        offsets_carries once), the summary written by the last tile."""
+        ranges = [r for r in sorted(ranges, key=lambda r: r[1]) if r[2]]
+        tiles_kernel = [self.programs.kernel("offsets", "offsets_tiles", pattern=_pattern(k)) for k, _, _ in ranges]
+        group, local_v, local_i = self._group_of(tiles_kernel[0], TILED_OFFSETS_GROUP)
+        for kernel in tiles_kernel[1:]:
+            group = min(group, self._group_of(kernel, TILED_OFFSETS_GROUP)[0])
+        carries = self.programs.kernel("offsets", "offsets_carries", pattern=_pattern(ranges[-1][0]))
+        group = min(group, self._group_of(carries, TILED_OFFSETS_GROUP)[0])
+        local = self._group_of(carries, group)[1:]  # (local arrays of that size)
+        tile_counts = [-(-n // group) for _, _, n in ranges]
+        num_tiles = sum(tile_counts)
+        if scratch.get("tiles") is None or scratch["tiles"].size < 4 * num_tiles:
+            scratch["tiles"] = cl_array.empty(self.queue, 4 * num_tiles, np.uint64)
+        tiles = scratch["tiles"]
+        events, tile_base = [], 0
+        for kernel, (_, base, n), count in zip(tiles_kernel, ranges, tile_counts):
+            events.append(kernel(self.queue, (count * group,), (group,), factors.data, np.uint32(n), np.uint32(base),
+                                 np.uint32(tile_base), flags.data, scratch["vertex_counts"].data,
+                                 scratch["index_counts"].data, scratch["vertex_offsets"].data,
+                                 scratch["index_offsets"].data, tiles.data, *local))
+            tile_base += count
+        events.append(carries(self.queue, (num_tiles * group,), (group,), np.uint32(num_tiles), tiles.data,
+                              scratch["vertex_offsets"].data, scratch["index_offsets"].data, summary.data, *local))
+        return events
+
+    def _group_of(self, kernel, cap: int) -> tuple:
+        """(work-group size, two local ulong arrays of that size) of a stage 3 kernel that scans
+        in one work-group: a power of two, at most ``cap`` and what the device allows for it
+        (asked once per kernel: a frame's launch needs no device query)."""
+        found = self._fused_groups.get((kernel, cap))
+        if found is None:
+            limit = min(cap, self.device.max_work_group_size,
+                        kernel.get_work_group_info(cl.kernel_work_group_info.WORK_GROUP_SIZE, self.device))
+            group = 1 << (int(limit).bit_length() - 1)  # a power of two: the scan's steps
+            found = self._fused_groups[kernel, cap] = (group, cl.LocalMemory(8 * group), cl.LocalMemory(8 * group))
+        return found
+
     def writes_summary(self, count: int, ranges) -> bool:
         """Whether stage 3 (``stage_counts``) can write a frame's summary: in one launch per
-        range, or with one scan; not with two scans (``CLTESS_ONE_SCAN=0``) nor without patches."""
-        return count > 0 and (self.one_scan or self._fused(count, ranges))
+        range, in two (tiles, carries), or with one scan; not with two scans
+        (``CLTESS_ONE_SCAN=0``) nor without patches."""
+        return count > 0 and (self.one_scan or self._fused(count, ranges) or self._tiled(count, ranges))
 
     def _fused_offsets(self, pattern, factors, base, n, vertex_counts, index_counts, vertex_offsets,
                        index_offsets, summary=None) -> cl.Event:
@@ -686,14 +762,7 @@ class Tessellator:
         (stages/offsets.cl), from offsets[base] on; summary: (flags, their number, summary
         array) for ``offsets_summary``."""
         kernel = self.programs.kernel("offsets", None if summary is None else "offsets_summary", pattern=pattern)
-        found = self._fused_groups.get((kernel, FUSED_OFFSETS_GROUP))
-        if found is None:  # (asked once per kernel: a frame's launch needs no device query)
-            limit = min(FUSED_OFFSETS_GROUP, self.device.max_work_group_size,
-                        kernel.get_work_group_info(cl.kernel_work_group_info.WORK_GROUP_SIZE, self.device))
-            group = 1 << (int(limit).bit_length() - 1)  # a power of two: the scan's steps
-            found = self._fused_groups[kernel, FUSED_OFFSETS_GROUP] = (
-                group, cl.LocalMemory(8 * group), cl.LocalMemory(8 * group))
-        group, local_v, local_i = found
+        group, local_v, local_i = self._group_of(kernel, FUSED_OFFSETS_GROUP)
         extra = () if summary is None else (summary[0].data, np.uint32(summary[1]), summary[2].data)
         return kernel(self.queue, (group,), (group,), factors.data, np.uint32(n), np.uint32(base),
                       vertex_counts.data, index_counts.data, vertex_offsets.data, index_offsets.data, *extra,
