@@ -58,7 +58,7 @@ class Session:
         self._scratch: dict = {}  # sharp_edges -> the per-patch arrays of stages 1-3
         self.frames = 0
         self._plans: list = []  # the last two frames' plans: their totals grow the buffers for the next
-        self._composed = None  # the (work, fused_offsets) of the last frame composed for the session's request
+        self._composed = None  # the (work, stage 3 choices) of the last frame composed for the session's request
 
     @property
     def device(self):
@@ -111,7 +111,8 @@ class Session:
         tessellator = self.tessellator
         # A new camera alone needs the programs of the last frame (they depend on the tolerance's
         # kind, not its camera); anything else is looked up (compose: found in the cache).
-        composed = None if request_overrides else (tessellator.work, tessellator.fused_offsets)
+        composed = None if request_overrides else (tessellator.work, tessellator.fused_offsets,
+                                                   tessellator.tiled_offsets, tessellator.one_scan)
         if composed is None or composed != self._composed:
             tessellator.compose(self.scene, request)
             self._composed = composed
