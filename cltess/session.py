@@ -58,7 +58,7 @@ class Session:
         self._scratch: dict = {}  # sharp_edges -> the per-patch arrays of stages 1-3
         self.frames = 0
         self._plans: list = []  # the last two frames' plans: their totals grow the buffers for the next
-        self._composed = None  # the (work, fused_offsets) of the last frame composed for the session's request
+        self._composed = None  # the (work, stage 3 choices) of the last frame composed for the session's request
 
     @property
     def device(self):
@@ -111,7 +111,8 @@ class Session:
         tessellator = self.tessellator
         # A new camera alone needs the programs of the last frame (they depend on the tolerance's
         # kind, not its camera); anything else is looked up (compose: found in the cache).
-        composed = None if request_overrides else (tessellator.work, tessellator.fused_offsets)
+        composed = None if request_overrides else (tessellator.work, tessellator.fused_offsets,
+                                                   tessellator.tiled_offsets, tessellator.one_scan)
         if composed is None or composed != self._composed:
             tessellator.compose(self.scene, request)
             self._composed = composed
@@ -127,10 +128,18 @@ class Session:
                 plan.settle()
             if plan.settled:
                 self.output.reserve(plan.num_vertices, plan.num_indices // 3)
-        plan = tessellator.plan_on(self._scene_data[key], request, started, self._scratch[key], defer_totals=True)
+        # The launches keep their arguments (the session's buffers): the next frame's launches
+        # with the same ones only enqueue (programs.Kernel).
+        programs = tessellator.programs
+        programs.keep_arguments = True
+        try:
+            plan = tessellator.plan_on(self._scene_data[key], request, started, self._scratch[key], defer_totals=True)
+            pending = tessellator.emit_async(plan, 0, plan.num_patches, out=self.output)
+        finally:
+            programs.keep_arguments = False
         self._plans = [*self._plans[-1:], plan]
         self.frames += 1
-        return tessellator.emit_async(plan, 0, plan.num_patches, out=self.output).result(on_device=True, wait=wait)
+        return pending.result(on_device=True, wait=wait)
 
     def __repr__(self) -> str:
         return (f"Session({self.scene.name!r}, {self.device.name.strip()!r}, {self.frames} frames, "

@@ -442,6 +442,12 @@ FRAMES = {"many_patches_frames": ("many_patches", "patch"), "many_patches_frames
 #: kinds (two ranges, the second from the first's total), culled patches, more patches than a tile.
 FUSED_OFFSETS = {"mixed_culled_fused_offsets": "mixed_culled", "many_patches_fused_offsets": "many_patches"}
 FUSED_OFFSETS_GROUP_HERE = 16
+#: Scenarios whose stage 3 is two launches (Tessellator.tiled_offsets: stages/offsets.cl
+#: offsets_tiles per range, offsets_carries, the plan's summary from the last tile), with tiles of
+#: TILED_OFFSETS_GROUP_HERE patches: two kinds, tiles across both, culled patches counted.  (Every
+#: other scenario's plan reads its summary from the summary scan, programs.py.)
+TILED_OFFSETS = {"mixed_culled_tiled_offsets": "mixed_culled", "many_patches_tiled_offsets": "many_patches"}
+TILED_OFFSETS_GROUP_HERE = 16
 #: Scenarios of silhouette refinement (cltess/backends/opencl/silhouette.py): a scene and the
 #: refiner's options, one frame from the eye (x, y, z); every per-frame kernel
 #: (silhouette_alpha, silhouette_levels, crack_free, counts, silhouette_vertices, indices).
@@ -562,6 +568,18 @@ def run_scenario(name: str, tessellator, out_dir: Path) -> dict:
             tess = tessellator.emit(plan, 0, plan.num_patches)
         finally:
             tessellator.fused_offsets, opencl.FUSED_OFFSETS_GROUP = saved
+    elif name in TILED_OFFSETS:
+        from cltess.backends.opencl import tessellator as opencl
+
+        scene, options = SCENARIOS[TILED_OFFSETS[name]]()
+        saved = tessellator.fused_offsets, tessellator.tiled_offsets, opencl.TILED_OFFSETS_GROUP
+        tessellator.fused_offsets, tessellator.tiled_offsets = False, True
+        opencl.TILED_OFFSETS_GROUP = TILED_OFFSETS_GROUP_HERE
+        try:  # its programs built before the plan's buffers (Tessellator.compose)
+            plan = tessellator.plan(scene, **options)
+            tess = tessellator.emit(plan, 0, plan.num_patches)
+        finally:
+            tessellator.fused_offsets, tessellator.tiled_offsets, opencl.TILED_OFFSETS_GROUP = saved
     elif name in FRAMES:
         from cltess.session import Session
 

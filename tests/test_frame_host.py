@@ -150,3 +150,24 @@ def test_a_cpu_devices_output_is_one_allocation_mapped_once(tessellator, tea_tab
     again = session.tessellate(eps=0.02)  # fewer: the same allocation
     assert session.output._parent.size == session.output.nbytes
     assert_same_output(again, tessellator.tessellate(tea_table, eps=0.02))
+
+
+def test_frames_keep_their_kernel_arguments_and_nothing_else_does(tessellator, tea_table):
+    """A Session frame's launches keep their arguments (programs.Kernel, Programs.keep_arguments),
+    so the next frame's launches with the same ones only enqueue; two sessions of different scenes
+    and one-shot calls on the same kernels in between still each get their own bits, and a
+    launch outside a frame keeps nothing (no buffer of a one-shot call outlives it)."""
+    from cltess.scene import Scene
+
+    part = Scene(np.asarray(tea_table.patches)[:200] * np.array([1.0, 1.0, 1.1, 1.0]),
+                 np.asarray(tea_table.object_ids)[:200], tea_table.camera, "part of the tea table, taller")
+    scenes = [tea_table, part]
+    sessions = [cltess.Session(scene, tessellator=tessellator, pixels=0.5) for scene in scenes]
+    crack_free = tessellator.programs.kernel("crack_free")
+    for turn in range(3):
+        for scene, session in zip(scenes, sessions):
+            frame = session.tessellate(camera=scene.camera)
+            assert not tessellator.programs.keep_arguments
+            assert crack_free.kept is not None  # kept for the next frame
+            assert_same_output(frame, tessellator.tessellate(scene, request=session.request_for(scene.camera)))
+            assert crack_free.kept is None  # the one-shot call's launch kept nothing

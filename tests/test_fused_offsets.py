@@ -90,3 +90,67 @@ def test_fused_offsets_setting(tessellator, monkeypatch):
     monkeypatch.setenv("CLTESS_FUSED_OFFSETS", "yes")
     with pytest.raises(ValueError, match="CLTESS_FUSED_OFFSETS"):
         opencl.Tessellator(tessellator.device)
+
+
+@pytest.mark.parametrize("path", ["fused/1", "fused/64", "fused", "tiled/1", "tiled/64", "tiled", "scan"])
+def test_stage_3_summary_is_the_totals_and_the_flag_counts(tessellator, rng, monkeypatch, path):
+    """A frame's summary (Tessellator.stage_counts(summary=...): stages/offsets.cl
+    offsets_summary on the last range, or the summary scan, programs.py): the vertex and index
+    totals, and how many of stage 1's flags have FLAG_CULLED and FLAG_SATURATED (other bits and
+    both together included), as NumPy counts them; the offsets are the plain stage 3's."""
+    from cltess.kinds import FLAG_CULLED, FLAG_FOLDED, FLAG_SATURATED
+    from cltess.pipeline import BEZIER, PN
+
+    if "/" in path:  # work-groups of this many patches: several tiles per range, tiles across kinds
+        monkeypatch.setattr(opencl, "FUSED_OFFSETS_GROUP" if path.startswith("fused") else "TILED_OFFSETS_GROUP",
+                            int(path.split("/")[1]))
+    tess = opencl.Tessellator(tessellator.device, work="patch")
+    tess.fused_offsets, tess.tiled_offsets, tess._cpu = path.startswith("fused"), path.startswith("tiled"), False
+    plain = opencl.Tessellator(tessellator.device, work="patch")
+    plain.fused_offsets = False
+    quads, triangles = random_factors(rng, 900), random_triangle_factors(rng, 450)
+    quads[::7] = 0
+    factors = np.concatenate([quads, triangles])
+    flags = rng.choice(np.array([0, FLAG_SATURATED, FLAG_CULLED, FLAG_FOLDED, FLAG_SATURATED | FLAG_CULLED,
+                                 FLAG_FOLDED | FLAG_SATURATED], np.int32), len(factors))
+    ranges = [(BEZIER, 0, 900), (PN, 900, 450)]
+    assert tess.writes_summary(len(factors), ranges)
+    summary = cl_array.empty(tess.queue, opencl.SUMMARY_FIELDS, np.uint64)
+    scratch = {}
+    for _ in range(2):  # again on the same arrays (a session's frames)
+        vertex_offsets, index_offsets, events = tess.stage_counts(
+            cl_array.to_device(tess.queue, factors), kind=ranges, scratch=scratch,
+            flags=cl_array.to_device(tess.queue, flags), summary=summary)
+    expected = plain.stage_counts(cl_array.to_device(plain.queue, factors), kind=ranges)
+    assert np.array_equal(vertex_offsets.get(), expected[0].get())
+    assert np.array_equal(index_offsets.get(), expected[1].get())
+    assert len(events) == 3 if tess.tiled_offsets or not tess.fused_offsets else 2  # fused: one per range
+    if tess.tiled_offsets:  # tiles per range, then carries; the tiles' records
+        group = min(opencl.TILED_OFFSETS_GROUP, 256)
+        records = scratch["tiles"].get().reshape(-1, 4)
+        assert len(records) >= -(-900 // group) + -(-450 // group)
+    assert summary.get().tolist() == [int(expected[0].get()[-1]), int(expected[1].get()[-1]),
+                                      int(np.count_nonzero(flags & FLAG_CULLED)),
+                                      int(np.count_nonzero(flags & FLAG_SATURATED))]
+
+
+def test_a_frame_reads_back_one_summary(tessellator, tea_table):
+    """A plan's totals and flag counts come back in one copy of stage 3's summary (fused, tiled
+    or scanned); with two scans (CLTESS_ONE_SCAN=0), as the totals and the flags (three copies),
+    with the same stats."""
+    import cltess
+
+    scene, stats = tea_table, []
+    for fused, tiled, one_scan in ((True, False, True), (False, True, True), (False, False, True),
+                                   (False, False, False)):
+        tess = opencl.Tessellator(tessellator.device, work="patch")
+        tess.fused_offsets, tess.tiled_offsets, tess.one_scan = fused, tiled, one_scan
+        plan = tess.plan(scene, pixels=0.5)
+        assert None not in (plan.stats["culled"], plan.stats["saturated"])
+        session = cltess.Session(scene, tessellator=tess, pixels=0.5)
+        session.tessellate()
+        frame = session.tessellate(wait=False)
+        pending = session._plans[-1]._pending
+        assert len(pending[2]) == (1 if one_scan else 3) and (pending[1] is None) == one_scan
+        stats.append((plan.stats, frame.stats))
+    assert stats[0] == stats[1] == stats[2] == stats[3]

@@ -224,11 +224,13 @@ def test_results_match_pocl(oclgrind, tmp_path_factory, tessellator, pass_name):
                 by_frame = load_npz(run.out_dir / f"{frame}.npz")
                 for field in ("positions", "normals", "uv", "patch_ids", "object_ids", "triangles", "factors"):
                     assert np.array_equal(getattr(by_frame, field), getattr(got, field)), f"{frame}: {field}"
-        for fused, base in scenarios.FUSED_OFFSETS.items():  # stages/offsets.cl: the same output
-            if base == name and fused in run.results:
+        for fused, base in {**scenarios.FUSED_OFFSETS, **scenarios.TILED_OFFSETS}.items():  # stages/offsets.cl
+            if base == name and fused in run.results:  # the same output, and the summary's same counts
                 by_fused = load_npz(run.out_dir / f"{fused}.npz")
                 for field in ("positions", "normals", "uv", "patch_ids", "object_ids", "triangles", "factors"):
                     assert np.array_equal(getattr(by_fused, field), getattr(got, field)), f"{fused}: {field}"
+                for stat in ("culled", "saturated", "vertices", "triangles"):
+                    assert run.results[fused]["stats"][stat] == run.results[name]["stats"][stat], f"{fused}: {stat}"
         if name in scenarios.VERIFIED:
             plan = tessellator.plan(scene, **options)
             ours = tessellator.verify(scene, plan, tessellator.emit(plan, 0, plan.num_patches))

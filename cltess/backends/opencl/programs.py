@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pyopencl as cl
+import pyopencl._cl as _cl
 from pyopencl.scan import GenericScanKernel
 from pyopencl.tools import get_or_register_dtype, match_dtype_to_c_struct
 
@@ -57,6 +58,17 @@ offset_pair offset_pair_of(ulong v, ulong i) { offset_pair p; p.v = v; p.i = i; 
 offset_pair offset_pair_add(offset_pair a, offset_pair b) { return offset_pair_of(a.v + b.v, a.i + b.i); }
 """
 
+#: The summary scan (``Programs.summary_scan``): (vertex, index, flags) triples, the flags of a
+#: patch counted as 1 in the low 32 bits if culled and 1 in the high 32 bits if saturated (a scene
+#: has fewer than 2**32 patches, so the halves never carry into each other).
+OFFSET_TRIPLE_FUNCTIONS = """
+#define FLAG_SATURATED {saturated}
+#define FLAG_CULLED {culled}
+offset_triple offset_triple_of(ulong v, ulong i, ulong f) {{ offset_triple t; t.v = v; t.i = i; t.f = f; return t; }}
+offset_triple offset_triple_add(offset_triple a, offset_triple b) {{ return offset_triple_of(a.v + b.v, a.i + b.i, a.f + b.f); }}
+ulong flag_counts(int flag) {{ return (ulong)((flag & FLAG_CULLED) != 0) | ((ulong)((flag & FLAG_SATURATED) != 0) << 32); }}
+"""
+
 #: The stage 4-5 programs of a work distribution other than a patch per work-item
 #: (tessellator.py WORK_DISTRIBUTIONS).
 WORK_STAGES = {"rows": ("vertex_rows",), "vertex": ("vertex_points",), "point": ("vertex_points", "triangles"),
@@ -72,19 +84,31 @@ class Kernel:
     scalar keep the generic path.  Every call site passes a kernel parameter the same NumPy
     type each time (the kernel's C type); a later value of another type is packed as the first
     call's type, or refused by ``struct`` (out of range, wrong kind), never reinterpreted.
+    A launch made while ``Programs.keep_arguments`` is on (a ``Session`` frame) keeps its
+    arguments; the next launch with equal arguments (the same buffers, equal scalars: stages 2-5
+    of frame after frame) enqueues the kernel alone, without setting them again (issue 15: a
+    frame's host cost).  Any other launch forgets them, so that no buffer outlives its
+    caller for the sake of this.
     Anything else (``get_work_group_info``, ``function_name``) is the pyopencl kernel's."""
 
-    __slots__ = ("kernel", "arg_types")
+    __slots__ = ("kernel", "arg_types", "programs", "kept")
 
-    def __init__(self, kernel: cl.Kernel):
+    def __init__(self, kernel: cl.Kernel, programs: "Programs | None" = None):
         self.kernel = kernel
         self.arg_types = None
+        self.programs = programs
+        self.kept = None  # the last launch's arguments, still set on the kernel (Programs.keep_arguments)
 
     def __call__(self, queue, global_size, local_size, *args, **options) -> cl.Event:
+        if args == self.kept and not options:  # set by the last launch and unchanged: enqueue alone
+            return _cl.enqueue_nd_range_kernel(queue, self.kernel, global_size, local_size, None, None, False, False)
         if self.arg_types is None:
             self.arg_types = tuple(a.dtype if isinstance(a, np.generic) else None for a in args)
             self.kernel.set_arg_types(self.arg_types)
-        return self.kernel(queue, global_size, local_size, *args, **options)
+        event = self.kernel(queue, global_size, local_size, *args, **options)
+        keep = self.programs is not None and self.programs.keep_arguments and not options
+        self.kept = args if keep else None
+        return event
 
     def __getattr__(self, name):
         return getattr(self.kernel, name)
@@ -148,6 +172,9 @@ class Programs:
         self._programs: dict = {}
         self._kernels: dict = {}
         self._seen: dict = {}  # Programs.kernel's look-up by the identity of its arguments
+        #: Whether launches keep their arguments for the next (``Kernel``): on while a Session
+        #: enqueues a frame, whose buffers live with the session.
+        self.keep_arguments = False
         self.offsets_scan = GenericScanKernel(
             context, np.uint64, arguments="__global const ulong *counts, __global ulong *offsets",
             input_expr="counts[i]", scan_expr="a+b", neutral="0",
@@ -164,6 +191,33 @@ class Programs:
             input_expr="offset_pair_of(vertex_counts[i], index_counts[i])", scan_expr="offset_pair_add(a, b)",
             neutral="offset_pair_of(0, 0)",
             output_statement="vertex_offsets[i + 1] = item.v; index_offsets[i + 1] = item.i;")
+        self._summary_scan = None
+
+    def summary_scan(self) -> GenericScanKernel:
+        """Stage 3's one scan that also writes a frame's summary (built on first use): the
+        vertex and index offsets as ``offsets_pair_scan``, and at the last patch ``summary``
+        = (vertex total, index total, patches culled, patches saturated) from stage 1's
+        ``flags``, so that the host reads one 32-byte buffer per frame (issue 15; the fused
+        stage 3's twin is ``offsets_summary`` in stages/offsets.cl)."""
+        if self._summary_scan is None:
+            from ...kinds import FLAG_CULLED, FLAG_SATURATED
+
+            triple, declaration = match_dtype_to_c_struct(
+                self.context.devices[0], "offset_triple",
+                np.dtype([("v", np.uint64), ("i", np.uint64), ("f", np.uint64)]))
+            triple = get_or_register_dtype("offset_triple", triple)
+            self._summary_scan = GenericScanKernel(
+                self.context, triple,
+                preamble=declaration + OFFSET_TRIPLE_FUNCTIONS.format(saturated=FLAG_SATURATED, culled=FLAG_CULLED),
+                arguments="__global const ulong *vertex_counts, __global const ulong *index_counts, "
+                          "__global const int *flags, __global ulong *vertex_offsets, "
+                          "__global ulong *index_offsets, __global ulong *summary",
+                input_expr="offset_triple_of(vertex_counts[i], index_counts[i], flag_counts(flags[i]))",
+                scan_expr="offset_triple_add(a, b)", neutral="offset_triple_of(0, 0, 0)",
+                output_statement="vertex_offsets[i + 1] = item.v; index_offsets[i + 1] = item.i; "
+                                 "if (i + 1 == N) { summary[0] = item.v; summary[1] = item.i; "
+                                 "summary[2] = item.f & 0xffffffffUL; summary[3] = item.f >> 32; }")
+        return self._summary_scan
 
     def kernel(self, stage: str, entry: str | None = None, kind=None, pattern=None, tolerance=None,
                crack: str = "crack/max.h") -> Kernel:
@@ -185,7 +239,7 @@ class Programs:
         if key not in self._programs:
             self._programs[key] = self.build(stage, headers, defines)
         if (key, entry) not in self._kernels:  # one Kernel object each: pyopencl caches its call set-up
-            self._kernels[key, entry] = Kernel(getattr(self._programs[key], entry or stage))
+            self._kernels[key, entry] = Kernel(getattr(self._programs[key], entry or stage), self)
         return self._kernels[key, entry]
 
     def compose(self, kind, pattern, tolerance, work: str = "patch") -> None:

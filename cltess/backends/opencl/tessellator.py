@@ -92,6 +92,17 @@ FUSED_OFFSETS_MAX_PATCHES = 1 << 14
 FUSED_OFFSETS_MAX_PATCHES_CPU = 1 << 11
 #: The fused launch's work-group size at most (a power of two; less where the device says so).
 FUSED_OFFSETS_GROUP = 1024
+#: Stage 3 in two launches (stages/offsets.cl offsets_tiles, offsets_carries) above the one-launch
+#: cap and up to this many patches, where a frame asks for its summary: the counts kernel and
+#: pyopencl.scan cost four launches and ~100 µs of host Python per frame (two temporary arrays;
+#: bench/RESULTS.md, "Issue 15: a frame's host cost, session 5").  The carries kernel reads every
+#: earlier tile's record per tile (quadratic in the tiles), so more patches keep the scan.
+TILED_OFFSETS_MAX_PATCHES = 1 << 18
+#: Patches per tile of the two-launch stage 3 (a power of two; less where the device says so).
+TILED_OFFSETS_GROUP = 256
+#: A frame's summary, written by stage 3 and read back in one copy (``Tessellator.stage_counts``):
+#: vertex total, index total, patches culled, patches saturated (uint64 each).
+SUMMARY_FIELDS = 4
 
 
 #: One context per device for the process: the tessellators of a device share it, and with it
@@ -118,6 +129,21 @@ def default_fused_offsets(device: cl.Device) -> bool:
     if chosen:
         return chosen == "1"
     return bool(device.type & cl.device_type.GPU) != bool(device.type & cl.device_type.CPU)
+
+
+def default_tiled_offsets(device: cl.Device) -> bool:
+    """Stage 3 in two launches where a plan asks for its summary and one launch would be too slow
+    (``TILED_OFFSETS_MAX_PATCHES``): ``CLTESS_TILED_OFFSETS`` (0 or 1) if set, else on GPUs only.
+    On CPUs (Intel's runtime, 2 vCPUs) its tiles' scans in local memory took twice the device
+    time of the counts kernel and pyopencl.scan (killeroo 1.3-1.6 against 0.7-0.9 ms, spheres 3.7
+    against 2.0, model zoo 8.5 against 4.0; bench/RESULTS.md, "Issue 15: a frame's host cost,
+    session 5").  Not on a device that says it is both (Oclgrind: "all")."""
+    chosen = os.environ.get("CLTESS_TILED_OFFSETS")
+    if chosen not in (None, "", "0", "1"):
+        raise ValueError(f"CLTESS_TILED_OFFSETS={chosen!r}: expected 0 or 1")
+    if chosen:
+        return chosen == "1"
+    return bool(device.type & cl.device_type.GPU) and not device.type & cl.device_type.CPU
 
 
 def pure_cpu(device: cl.Device) -> bool:
@@ -213,6 +239,8 @@ class Tessellator:
         self.fused_offsets = default_fused_offsets(self.device)  # stage 3 by stages/offsets.cl
         self._cpu = pure_cpu(self.device)  # stage 3 fused up to FUSED_OFFSETS_MAX_PATCHES_CPU only
         self._kind_patch_sizes: dict = {}
+        self._fused_groups: dict = {}  # (a stage 3 kernel, group cap) -> (work-group size, local arrays): _group_of
+        self.tiled_offsets = default_tiled_offsets(self.device)  # stage 3 in two launches above the fused cap
 
     @property
     def per_item(self) -> int:
@@ -285,12 +313,18 @@ class Tessellator:
                 self.programs.compose(kind, pattern, tolerance, self.work)
                 if self.fused_offsets:
                     self.programs.kernel("offsets", pattern=pattern)
+                    self.programs.kernel("offsets", "offsets_summary", pattern=pattern)
+                if self.tiled_offsets:
+                    self.programs.kernel("offsets", "offsets_tiles", pattern=pattern)
+                    self.programs.kernel("offsets", "offsets_carries", pattern=pattern)
                 if self.work.endswith("-prep"):  # before the plan's buffers (prepared_scratch)
                     self.prepared_scratch(kind, pattern, kind.count(scene))
                 if pattern.fixed_point:  # SD-2's level functions
                     build_level_function_programs(self)
                 if pattern.primitive == "strips":
                     build_strip_programs(self, pattern)
+        if self.one_scan:  # stage 3's scan that writes a frame's summary (stage_counts)
+            self.programs.summary_scan()
         if request.bound == "integral":
             self.programs.kernel("integral_bound")
 
@@ -351,15 +385,24 @@ class Tessellator:
         crack = next((p.pattern.crack for p in parts if p.pattern.crack != "crack/max.h"), "crack/max.h")
         final, events["crack_free"] = self.stage_crack_free(factors, data.groups, crack, out=scratch.get("final"))
         scratch["final"] = final
+        ranges = [(part.pattern, part.base, part.count) for part in parts]
+        summary = None
+        if self.writes_summary(count, ranges):  # stage 3 writes totals and flag counts: one read
+            if "summary" not in scratch:
+                scratch["summary"] = cl_array.empty(self.queue, SUMMARY_FIELDS, np.uint64)
+            summary = scratch["summary"]
         vertex_offsets, index_offsets, events["counts"] = self.stage_counts(
-            final, [(part.pattern, part.base, part.count) for part in parts], scratch=scratch)
+            final, ranges, scratch=scratch, flags=flags, summary=summary)
         strips = strip_offsets(self, final, parts) if strip_parts(parts) else (None, [])
         events["counts"] += strips[1]
-        totals, flag_values = self._read_back_arrays(scratch if defer_totals else None, count)
-        copies = [
-            cl.enqueue_copy(self.queue, totals[:1], vertex_offsets.data, src_offset=8 * count, is_blocking=False),
-            cl.enqueue_copy(self.queue, totals[1:], index_offsets.data, src_offset=8 * count, is_blocking=False),
-            cl.enqueue_copy(self.queue, flag_values, flags.data, is_blocking=False)]
+        totals, flag_values = self._read_back_arrays(scratch if defer_totals else None, count, summary is None)
+        if summary is not None:
+            copies = [cl.enqueue_copy(self.queue, totals, summary.data, is_blocking=False)]
+        else:
+            copies = [
+                cl.enqueue_copy(self.queue, totals[:1], vertex_offsets.data, src_offset=8 * count, is_blocking=False),
+                cl.enqueue_copy(self.queue, totals[1:2], index_offsets.data, src_offset=8 * count, is_blocking=False),
+                cl.enqueue_copy(self.queue, flag_values, flags.data, is_blocking=False)]
         stats = {"patches": count, "culled": None, "saturated": None, "vertices": None, "triangles": None,
                  **data.stats, **level_stats}  # the counts: Plan.settle
         plan = Plan(scene.name, count, parts, data.objects, final, vertex_offsets, index_offsets, None, None,
@@ -376,31 +419,33 @@ class Tessellator:
                 [plan._host["factors"][p.base:p.base + p.count] for p in parts if p.pattern.dyadic]))
         return plan
 
-    #: Page-locked host arrays for the totals and flags of a Session's frames: three, used in
-    #: turn (at most two frames are unsettled at once: Session.tessellate).
+    #: Page-locked host arrays for the summaries (or totals and flags) of a Session's frames:
+    #: three, used in turn (at most two frames are unsettled at once: Session.tessellate).
     READ_BACK_SLOTS = 3
 
-    def _read_back_arrays(self, scratch: dict | None, count: int) -> tuple[np.ndarray, np.ndarray]:
-        """(totals (2,) uint64, flags (count,) int32) host arrays that stage 3's totals and
-        stage 1's flags are copied into: fresh NumPy arrays, or, for a Session's deferred
-        frames (``scratch``), page-locked ones kept with the scratch and used in turn: on the
-        H100 a non-blocking read of 8 bytes cost the host 10 µs into page-locked memory and
-        17.5 µs into pageable memory (bench/RESULTS.md, "Session 4 on the H100")."""
+    def _read_back_arrays(self, scratch: dict | None, count: int, flags: bool = True):
+        """(totals (SUMMARY_FIELDS,) uint64, flags (count,) int32 or None) host arrays that
+        stage 3's summary (totals, culled, saturated), or its two totals and stage 1's flags
+        (``flags``), are copied into: fresh NumPy arrays, or, for a Session's deferred frames
+        (``scratch``), page-locked ones kept with the scratch and used in turn: on the H100 a
+        non-blocking read of 8 bytes cost the host 10 µs into page-locked memory and 17.5 µs
+        into pageable memory (bench/RESULTS.md, "Session 4 on the H100")."""
         if scratch is None:
-            return np.zeros(2, np.uint64), np.empty(count, np.int32)
+            return np.zeros(SUMMARY_FIELDS, np.uint64), np.empty(count, np.int32) if flags else None
+        head = 8 * SUMMARY_FIELDS
         if "read_back" not in scratch:
             slots = []
             for _ in range(self.READ_BACK_SLOTS):  # each: one buffer, mapped once and kept mapped
-                size = 16 + 4 * max(count, 1)
+                size = head + 4 * max(count, 1)
                 buffer = cl.Buffer(self.context, cl.mem_flags.READ_WRITE | cl.mem_flags.ALLOC_HOST_PTR, size)
                 memory, _ = cl.enqueue_map_buffer(self.queue, buffer, cl.map_flags.READ | cl.map_flags.WRITE, 0,
                                                   (size,), np.uint8, is_blocking=True)
-                slots.append((buffer, memory[:16].view(np.uint64), memory[16:16 + 4 * count].view(np.int32)))
+                slots.append((buffer, memory[:head].view(np.uint64), memory[head:head + 4 * count].view(np.int32)))
             scratch["read_back"], scratch["read_back_turn"] = slots, 0
         turn = scratch["read_back_turn"]
         scratch["read_back_turn"] = (turn + 1) % self.READ_BACK_SLOTS
-        _, totals, flags = scratch["read_back"][turn]
-        return totals, flags
+        _, totals, flag_values = scratch["read_back"][turn]
+        return totals, flag_values if flags else None
 
     def upload_groups(self, groups, num_patches: int) -> dict:
         """Stage 2's edge groups (cltess.crack.adjacency.EdgeGroups over the P * 4 edge slots)
@@ -622,12 +667,15 @@ class Tessellator:
             final.data)
         return final, [event]
 
-    def stage_counts(self, factors, kind=BEZIER, scratch: dict | None = None):
+    def stage_counts(self, factors, kind=BEZIER, scratch: dict | None = None, flags=None, summary=None):
         """Stage 3.  factors (P, 4) -> vertex and index offsets (P+1,) uint64, [P] = total.
 
         kind: the kind (a PatchKind or its name) or the pattern of every patch, or a list of
         (kind or pattern, base, count) ranges covering 0..P-1.  scratch: a dict keeping the
-        count and offset arrays for the next call (``plan_on``)."""
+        count and offset arrays for the next call (``plan_on``).  summary: a (4,) uint64 device
+        array that stage 3 fills with (vertex total, index total, patches culled, patches
+        saturated) from stage 1's ``flags`` (P,) int32, so that the host reads one buffer
+        (``writes_summary`` says where it can: not with two scans)."""
         count = len(factors)
         ranges = [(kind, 0, count)] if not isinstance(kind, (list, tuple)) else kind
         scratch = {} if scratch is None else scratch
@@ -638,18 +686,25 @@ class Tessellator:
                 scratch[name] = cl_array.zeros(self.queue, count + 1, np.uint64)
         vertex_counts, index_counts = scratch["vertex_counts"], scratch["index_counts"]
         vertex_offsets, index_offsets = scratch["vertex_offsets"], scratch["index_offsets"]
-        cap = min(FUSED_OFFSETS_MAX_PATCHES, FUSED_OFFSETS_MAX_PATCHES_CPU) if self._cpu else FUSED_OFFSETS_MAX_PATCHES
-        fused = self.fused_offsets and count <= cap and not any(
-            _pattern(k).counts_walk for k, _, n in ranges if n)  # a walk per patch wants the whole device
-        if fused:  # one launch per range, in order
+        if summary is not None and not self.writes_summary(count, ranges):
+            raise ValueError("stage 3 writes a summary in one launch or with one scan (CLTESS_ONE_SCAN=1)")
+        if summary is not None and self._tiled(count, ranges):  # two launches: tiles, then their carries
+            return vertex_offsets, index_offsets, self._tiled_offsets(ranges, factors, flags, summary, scratch)
+        if self._fused(count, ranges):  # one launch per range, in order; the last one writes the summary
+            ranges = [r for r in sorted(ranges, key=lambda r: r[1]) if r[2]]
             events = [self._fused_offsets(_pattern(k), factors, base, n, vertex_counts, index_counts,
-                                          vertex_offsets, index_offsets)
-                      for k, base, n in sorted(ranges, key=lambda r: r[1]) if n]
+                                          vertex_offsets, index_offsets,
+                                          (flags, count, summary) if summary is not None and at == len(ranges) - 1
+                                          else None)
+                      for at, (k, base, n) in enumerate(ranges)]
             return vertex_offsets, index_offsets, events
         events = [self.programs.kernel("counts", pattern=_pattern(k))(
             self.queue, _global_size(n), None, factors.data, np.uint32(n), np.uint32(base),
             vertex_counts.data, index_counts.data) for k, base, n in ranges if n]
-        if self.one_scan:  # both offsets in one scan of (vertex, index) pairs (programs.py)
+        if summary is not None:  # the pair scan with the flags' counts, and the summary at the end
+            events.append(self.programs.summary_scan()(vertex_counts, index_counts, flags, vertex_offsets,
+                                                       index_offsets, summary, allocator=self._scan_memory))
+        elif self.one_scan:  # both offsets in one scan of (vertex, index) pairs (programs.py)
             events.append(self.programs.offsets_pair_scan(vertex_counts, index_counts, vertex_offsets,
                                                           index_offsets, allocator=self._scan_memory))
         else:
@@ -657,17 +712,76 @@ class Tessellator:
                        self.programs.offsets_scan(index_counts, index_offsets, allocator=self._scan_memory)]
         return vertex_offsets, index_offsets, events
 
+    def _fused(self, count: int, ranges) -> bool:
+        """Whether stage 3 of ``count`` patches in these ranges is one launch per range
+        (stages/offsets.cl): ``fused_offsets``, up to the device type's cap, and no pattern
+        whose counts walk it (a walk per patch wants the whole device)."""
+        cap = min(FUSED_OFFSETS_MAX_PATCHES, FUSED_OFFSETS_MAX_PATCHES_CPU) if self._cpu else FUSED_OFFSETS_MAX_PATCHES
+        return self.fused_offsets and count <= cap and not any(_pattern(k).counts_walk for k, _, n in ranges if n)
+
+    def _tiled(self, count: int, ranges) -> bool:
+        """Whether stage 3 with a summary is two launches (``_tiled_offsets``): ``tiled_offsets``,
+        not one launch (``_fused``), up to ``TILED_OFFSETS_MAX_PATCHES``, no pattern whose counts
+        walk it."""
+        return (self.tiled_offsets and count <= TILED_OFFSETS_MAX_PATCHES and not self._fused(count, ranges)
+                and not any(_pattern(k).counts_walk for k, _, n in ranges if n))
+
+    def _tiled_offsets(self, ranges, factors, flags, summary, scratch: dict) -> list:
+        """Stage 3 in two launches (stages/offsets.cl offsets_tiles per range, then
+        offsets_carries once), the summary written by the last tile."""
+        ranges = [r for r in sorted(ranges, key=lambda r: r[1]) if r[2]]
+        tiles_kernel = [self.programs.kernel("offsets", "offsets_tiles", pattern=_pattern(k)) for k, _, _ in ranges]
+        group, local_v, local_i = self._group_of(tiles_kernel[0], TILED_OFFSETS_GROUP)
+        for kernel in tiles_kernel[1:]:
+            group = min(group, self._group_of(kernel, TILED_OFFSETS_GROUP)[0])
+        carries = self.programs.kernel("offsets", "offsets_carries", pattern=_pattern(ranges[-1][0]))
+        group = min(group, self._group_of(carries, TILED_OFFSETS_GROUP)[0])
+        local = self._group_of(carries, group)[1:]  # (local arrays of that size)
+        tile_counts = [-(-n // group) for _, _, n in ranges]
+        num_tiles = sum(tile_counts)
+        if scratch.get("tiles") is None or scratch["tiles"].size < 4 * num_tiles:
+            scratch["tiles"] = cl_array.empty(self.queue, 4 * num_tiles, np.uint64)
+        tiles = scratch["tiles"]
+        events, tile_base = [], 0
+        for kernel, (_, base, n), count in zip(tiles_kernel, ranges, tile_counts):
+            events.append(kernel(self.queue, (count * group,), (group,), factors.data, np.uint32(n), np.uint32(base),
+                                 np.uint32(tile_base), flags.data, scratch["vertex_counts"].data,
+                                 scratch["index_counts"].data, scratch["vertex_offsets"].data,
+                                 scratch["index_offsets"].data, tiles.data, *local))
+            tile_base += count
+        events.append(carries(self.queue, (num_tiles * group,), (group,), np.uint32(num_tiles), tiles.data,
+                              scratch["vertex_offsets"].data, scratch["index_offsets"].data, summary.data, *local))
+        return events
+
+    def _group_of(self, kernel, cap: int) -> tuple:
+        """(work-group size, two local ulong arrays of that size) of a stage 3 kernel that scans
+        in one work-group: a power of two, at most ``cap`` and what the device allows for it
+        (asked once per kernel: a frame's launch needs no device query)."""
+        found = self._fused_groups.get((kernel, cap))
+        if found is None:
+            limit = min(cap, self.device.max_work_group_size,
+                        kernel.get_work_group_info(cl.kernel_work_group_info.WORK_GROUP_SIZE, self.device))
+            group = 1 << (int(limit).bit_length() - 1)  # a power of two: the scan's steps
+            found = self._fused_groups[kernel, cap] = (group, cl.LocalMemory(8 * group), cl.LocalMemory(8 * group))
+        return found
+
+    def writes_summary(self, count: int, ranges) -> bool:
+        """Whether stage 3 (``stage_counts``) can write a frame's summary: in one launch per
+        range, in two (tiles, carries), or with one scan; not with two scans
+        (``CLTESS_ONE_SCAN=0``) nor without patches."""
+        return count > 0 and (self.one_scan or self._fused(count, ranges) or self._tiled(count, ranges))
+
     def _fused_offsets(self, pattern, factors, base, n, vertex_counts, index_counts, vertex_offsets,
-                       index_offsets) -> cl.Event:
+                       index_offsets, summary=None) -> cl.Event:
         """Stage 3 for patches base .. base+n-1 of one pattern in one work-group
-        (stages/offsets.cl), from offsets[base] on."""
-        kernel = self.programs.kernel("offsets", pattern=pattern)
-        limit = min(FUSED_OFFSETS_GROUP, self.device.max_work_group_size,
-                    kernel.get_work_group_info(cl.kernel_work_group_info.WORK_GROUP_SIZE, self.device))
-        group = 1 << (int(limit).bit_length() - 1)  # a power of two: the scan's steps
+        (stages/offsets.cl), from offsets[base] on; summary: (flags, their number, summary
+        array) for ``offsets_summary``."""
+        kernel = self.programs.kernel("offsets", None if summary is None else "offsets_summary", pattern=pattern)
+        group, local_v, local_i = self._group_of(kernel, FUSED_OFFSETS_GROUP)
+        extra = () if summary is None else (summary[0].data, np.uint32(summary[1]), summary[2].data)
         return kernel(self.queue, (group,), (group,), factors.data, np.uint32(n), np.uint32(base),
-                      vertex_counts.data, index_counts.data, vertex_offsets.data, index_offsets.data,
-                      cl.LocalMemory(8 * group), cl.LocalMemory(8 * group))
+                      vertex_counts.data, index_counts.data, vertex_offsets.data, index_offsets.data, *extra,
+                      local_v, local_i)
 
     def _vertex_arrays(self, n: int) -> dict:
         """The vertex record's arrays (VERTEX_RECORD, in the kernel's argument order)."""
@@ -1132,7 +1246,7 @@ class Plan:
     strip_offsets: cl_array.Array | None = None  # strip patterns' (P+1,) strip index offsets
     num_strip_indices: int = 0
     wait_ms: float = 0.0  # host ms blocked waiting for stages 1-3's totals (wall_ms["waits"])
-    _pending: tuple | None = None  # (totals, flags, their copies' events) until settle
+    _pending: tuple | None = None  # (summary or totals, flags or None, their copies' events) until settle
 
     @property
     def settled(self) -> bool:
@@ -1154,9 +1268,13 @@ class Plan:
         self._pending = None
         self.num_vertices, self.num_indices = int(totals[0]), int(totals[1])
         check_totals(self.name, self.num_vertices)
-        self.stats.update(culled=int(np.count_nonzero(flags & FLAG_CULLED)),
-                          saturated=int(np.count_nonzero(flags & FLAG_SATURATED)),
-                          vertices=self.num_vertices, triangles=self.num_indices // 3)
+        if flags is None:  # stage 3's summary (Tessellator.stage_counts)
+            culled, saturated = int(totals[2]), int(totals[3])
+        else:
+            culled = int(np.count_nonzero(flags & FLAG_CULLED))
+            saturated = int(np.count_nonzero(flags & FLAG_SATURATED))
+        self.stats.update(culled=culled, saturated=saturated, vertices=self.num_vertices,
+                          triangles=self.num_indices // 3)
         return self
 
     def output_factors(self, first: int, last: int) -> tuple[np.ndarray, np.ndarray | None]:
