@@ -17,6 +17,52 @@
  * per frame instead of three): summary[0], [1] the vertex and index totals (offsets[P]),
  * summary[2], [3] how many of flags[0 .. num_flags-1] (stage 1's, every patch of the scene) have
  * FLAG_CULLED and FLAG_SATURATED. */
+/* Patch p's counts (as counts.cl: pattern_vertex_count, pattern_primitives in count mode),
+ * stored; returns (vertices, indices). */
+inline ulong2 count_patch(__global const int4 *factors, uint p, __global ulong *vertex_counts,
+                          __global ulong *index_counts)
+{
+    int collapsed;
+    int4 f = patch_factors(factors[p], &collapsed);
+    ulong v = pattern_vertex_count(f), i = 3 * (ulong)pattern_primitives(f, collapsed, 0, 0);
+    vertex_counts[p] = v;
+    index_counts[p] = i;
+    return (ulong2)(v, i);
+}
+
+/* The Hillis-Steele inclusive scan of the work-group's (v, i) in local memory: work-item l's is
+ * left in scan_v[l], scan_i[l] (G = get_local_size(0) a power of two; scan_* free on entry). */
+inline void scan_pairs(ulong v, ulong i, __local ulong *scan_v, __local ulong *scan_i)
+{
+    uint l = (uint)get_local_id(0), group = (uint)get_local_size(0);
+    scan_v[l] = v;
+    scan_i[l] = i;
+    barrier(CLK_LOCAL_MEM_FENCE);
+    for (uint d = 1; d < group; d <<= 1) {
+        ulong add_v = l >= d ? scan_v[l - d] : 0, add_i = l >= d ? scan_i[l - d] : 0;
+        barrier(CLK_LOCAL_MEM_FENCE);
+        scan_v[l] += add_v;
+        scan_i[l] += add_i;
+        barrier(CLK_LOCAL_MEM_FENCE);
+    }
+}
+
+/* The sum of value over the work-group, in every work-item: a tree in scratch (G ulongs, G a
+ * power of two), after a barrier, so that what scratch held before has been read. */
+inline ulong group_sum(ulong value, __local ulong *scratch)
+{
+    uint l = (uint)get_local_id(0), group = (uint)get_local_size(0);
+    barrier(CLK_LOCAL_MEM_FENCE);
+    scratch[l] = value;
+    barrier(CLK_LOCAL_MEM_FENCE);
+    for (uint step = group >> 1; step > 0; step >>= 1) {
+        if (l < step)
+            scratch[l] += scratch[l + step];
+        barrier(CLK_LOCAL_MEM_FENCE);
+    }
+    return scratch[0];
+}
+
 /* The counts and offsets of one range; returns the offsets past its end (the totals, for the
  * last range), the same in every work-item. */
 inline ulong2 offsets_of_range(__global const int4 *factors, uint num_patches, uint patch_base,
@@ -28,26 +74,9 @@ inline ulong2 offsets_of_range(__global const int4 *factors, uint num_patches, u
     ulong carry_v = vertex_offsets[patch_base], carry_i = index_offsets[patch_base];
     for (uint tile = 0; tile < num_patches; tile += group) {
         uint q = tile + l;
-        ulong v = 0, i = 0;
-        if (q < num_patches) {
-            uint p = patch_base + q;
-            int collapsed;
-            int4 f = patch_factors(factors[p], &collapsed);
-            v = pattern_vertex_count(f);
-            i = 3 * (ulong)pattern_primitives(f, collapsed, 0, 0);
-            vertex_counts[p] = v;
-            index_counts[p] = i;
-        }
-        scan_v[l] = v;
-        scan_i[l] = i;
-        barrier(CLK_LOCAL_MEM_FENCE);
-        for (uint d = 1; d < group; d <<= 1) {
-            ulong add_v = l >= d ? scan_v[l - d] : 0, add_i = l >= d ? scan_i[l - d] : 0;
-            barrier(CLK_LOCAL_MEM_FENCE);
-            scan_v[l] += add_v;
-            scan_i[l] += add_i;
-            barrier(CLK_LOCAL_MEM_FENCE);
-        }
+        ulong2 counts = q < num_patches ? count_patch(factors, patch_base + q, vertex_counts, index_counts)
+                                        : (ulong2)(0, 0);
+        scan_pairs(counts.x, counts.y, scan_v, scan_i);
         if (q < num_patches) {
             vertex_offsets[patch_base + q + 1] = carry_v + scan_v[l];
             index_offsets[patch_base + q + 1] = carry_i + scan_i[l];
@@ -83,21 +112,13 @@ __kernel void offsets_summary(__global const int4 *factors, uint num_patches, ui
         culled += (flag & FLAG_CULLED) != 0;
         saturated += (flag & FLAG_SATURATED) != 0;
     }
-    scan_v[l] = culled;  /* (the range's last barrier: every work-item is done with scan_*) */
-    scan_i[l] = saturated;
-    barrier(CLK_LOCAL_MEM_FENCE);
-    for (uint step = group >> 1; step > 0; step >>= 1) {  /* a tree sum (group: a power of two) */
-        if (l < step) {
-            scan_v[l] += scan_v[l + step];
-            scan_i[l] += scan_i[l + step];
-        }
-        barrier(CLK_LOCAL_MEM_FENCE);
-    }
+    culled = group_sum(culled, scan_v);
+    saturated = group_sum(saturated, scan_i);
     if (l == 0) {
         summary[0] = totals.x;
         summary[1] = totals.y;
-        summary[2] = scan_v[0];
-        summary[3] = scan_i[0];
+        summary[2] = culled;
+        summary[3] = saturated;
     }
 }
 
@@ -120,44 +141,25 @@ __kernel void offsets_tiles(__global const int4 *factors, uint num_patches, uint
 {
     uint l = (uint)get_local_id(0), group = (uint)get_local_size(0), tile = (uint)get_group_id(0);
     uint first = tile * group, q = first + l, p = patch_base + q;
-    ulong v = 0, i = 0, f = 0;
+    ulong2 counts = (ulong2)(0, 0);
+    ulong f = 0;
     if (q < num_patches) {
-        int collapsed, flag = flags[p];
-        int4 factor = patch_factors(factors[p], &collapsed);
-        v = pattern_vertex_count(factor);
-        i = 3 * (ulong)pattern_primitives(factor, collapsed, 0, 0);
-        vertex_counts[p] = v;
-        index_counts[p] = i;
+        int flag = flags[p];
+        counts = count_patch(factors, p, vertex_counts, index_counts);
         f = (ulong)((flag & FLAG_CULLED) != 0) | ((ulong)((flag & FLAG_SATURATED) != 0) << 32);
     }
-    scan_v[l] = v;
-    scan_i[l] = i;
-    barrier(CLK_LOCAL_MEM_FENCE);
-    for (uint d = 1; d < group; d <<= 1) {  /* Hillis-Steele, as offsets_of_range */
-        ulong add_v = l >= d ? scan_v[l - d] : 0, add_i = l >= d ? scan_i[l - d] : 0;
-        barrier(CLK_LOCAL_MEM_FENCE);
-        scan_v[l] += add_v;
-        scan_i[l] += add_i;
-        barrier(CLK_LOCAL_MEM_FENCE);
-    }
+    scan_pairs(counts.x, counts.y, scan_v, scan_i);
     if (q < num_patches) {
         vertex_offsets[p + 1] = scan_v[l];
         index_offsets[p + 1] = scan_i[l];
     }
     ulong sum_v = scan_v[group - 1], sum_i = scan_i[group - 1];
-    barrier(CLK_LOCAL_MEM_FENCE);  /* every work-item has read scan_v before it holds the flags */
-    scan_v[l] = f;
-    barrier(CLK_LOCAL_MEM_FENCE);
-    for (uint step = group >> 1; step > 0; step >>= 1) {
-        if (l < step)
-            scan_v[l] += scan_v[l + step];
-        barrier(CLK_LOCAL_MEM_FENCE);
-    }
+    f = group_sum(f, scan_v);  /* (its barrier: every work-item has read scan_v) */
     if (l == 0) {
         __global ulong *record = tiles + 4 * (ulong)(tile_base + tile);
         record[0] = sum_v;
         record[1] = sum_i;
-        record[2] = scan_v[0];
+        record[2] = f;
         record[3] = (ulong)(patch_base + first) | ((ulong)min(group, num_patches - first) << 32);
     }
 }
@@ -174,18 +176,8 @@ __kernel void offsets_carries(uint num_tiles, __global const ulong *tiles, __glo
         carry_i += tiles[4 * (ulong)t + 1];
         flag_counts += tiles[4 * (ulong)t + 2];
     }
-    scan_v[l] = carry_v;
-    scan_i[l] = carry_i;
-    barrier(CLK_LOCAL_MEM_FENCE);
-    for (uint step = group >> 1; step > 0; step >>= 1) {
-        if (l < step) {
-            scan_v[l] += scan_v[l + step];
-            scan_i[l] += scan_i[l + step];
-        }
-        barrier(CLK_LOCAL_MEM_FENCE);
-    }
-    carry_v = scan_v[0];
-    carry_i = scan_i[0];
+    carry_v = group_sum(carry_v, scan_v);
+    carry_i = group_sum(carry_i, scan_i);
     ulong span = tiles[4 * (ulong)tile + 3];
     uint first = (uint)span, count = (uint)(span >> 32);
     for (uint q = l; q < count; q += group) {
@@ -193,16 +185,9 @@ __kernel void offsets_carries(uint num_tiles, __global const ulong *tiles, __glo
         index_offsets[first + q + 1] += carry_i;
     }
     if (last) {  /* (uniform across the work-group: its barriers are reached by all or none) */
-        barrier(CLK_LOCAL_MEM_FENCE);  /* every work-item has read the carries */
-        scan_v[l] = flag_counts;
-        barrier(CLK_LOCAL_MEM_FENCE);
-        for (uint step = group >> 1; step > 0; step >>= 1) {
-            if (l < step)
-                scan_v[l] += scan_v[l + step];
-            barrier(CLK_LOCAL_MEM_FENCE);
-        }
+        flag_counts = group_sum(flag_counts, scan_v);
         if (l == 0) {
-            ulong flags_all = scan_v[0] + tiles[4 * (ulong)tile + 2];
+            ulong flags_all = flag_counts + tiles[4 * (ulong)tile + 2];
             summary[0] = carry_v + tiles[4 * (ulong)tile];
             summary[1] = carry_i + tiles[4 * (ulong)tile + 1];
             summary[2] = flags_all & 0xffffffffUL;
