@@ -688,9 +688,10 @@ class Tessellator:
         vertex_offsets, index_offsets = scratch["vertex_offsets"], scratch["index_offsets"]
         if summary is not None and not self.writes_summary(count, ranges):
             raise ValueError("stage 3 writes a summary in one launch or with one scan (CLTESS_ONE_SCAN=1)")
-        if summary is not None and self._tiled(count, ranges):  # two launches: tiles, then their carries
+        path = self._stage3_path(count, ranges)
+        if summary is not None and path == "tiled":  # two launches: tiles, then their carries
             return vertex_offsets, index_offsets, self._tiled_offsets(ranges, factors, flags, summary, scratch)
-        if self._fused(count, ranges):  # one launch per range, in order; the last one writes the summary
+        if path == "fused":  # one launch per range, in order; the last one writes the summary
             ranges = [r for r in sorted(ranges, key=lambda r: r[1]) if r[2]]
             events = [self._fused_offsets(_pattern(k), factors, base, n, vertex_counts, index_counts,
                                           vertex_offsets, index_offsets,
@@ -712,19 +713,20 @@ class Tessellator:
                        self.programs.offsets_scan(index_counts, index_offsets, allocator=self._scan_memory)]
         return vertex_offsets, index_offsets, events
 
-    def _fused(self, count: int, ranges) -> bool:
-        """Whether stage 3 of ``count`` patches in these ranges is one launch per range
-        (stages/offsets.cl): ``fused_offsets``, up to the device type's cap, and no pattern
-        whose counts walk it (a walk per patch wants the whole device)."""
+    def _stage3_path(self, count: int, ranges) -> str:
+        """How stage 3 of ``count`` patches in these ranges runs: "fused", one launch per range
+        (stages/offsets.cl; ``fused_offsets``, up to the device type's cap); "tiled", two
+        launches (``_tiled_offsets``; ``tiled_offsets``, up to ``TILED_OFFSETS_MAX_PATCHES``,
+        only where a summary is asked for); else "scan" (counts kernel and pyopencl.scan).  Never
+        one of the first two for a pattern whose counts walk the patch (that wants the whole device)."""
+        if any(_pattern(k).counts_walk for k, _, n in ranges if n):
+            return "scan"
         cap = min(FUSED_OFFSETS_MAX_PATCHES, FUSED_OFFSETS_MAX_PATCHES_CPU) if self._cpu else FUSED_OFFSETS_MAX_PATCHES
-        return self.fused_offsets and count <= cap and not any(_pattern(k).counts_walk for k, _, n in ranges if n)
-
-    def _tiled(self, count: int, ranges) -> bool:
-        """Whether stage 3 with a summary is two launches (``_tiled_offsets``): ``tiled_offsets``,
-        not one launch (``_fused``), up to ``TILED_OFFSETS_MAX_PATCHES``, no pattern whose counts
-        walk it."""
-        return (self.tiled_offsets and count <= TILED_OFFSETS_MAX_PATCHES and not self._fused(count, ranges)
-                and not any(_pattern(k).counts_walk for k, _, n in ranges if n))
+        if self.fused_offsets and count <= cap:
+            return "fused"
+        if self.tiled_offsets and count <= TILED_OFFSETS_MAX_PATCHES:
+            return "tiled"
+        return "scan"
 
     def _tiled_offsets(self, ranges, factors, flags, summary, scratch: dict) -> list:
         """Stage 3 in two launches (stages/offsets.cl offsets_tiles per range, then
@@ -769,7 +771,7 @@ class Tessellator:
         """Whether stage 3 (``stage_counts``) can write a frame's summary: in one launch per
         range, in two (tiles, carries), or with one scan; not with two scans
         (``CLTESS_ONE_SCAN=0``) nor without patches."""
-        return count > 0 and (self.one_scan or self._fused(count, ranges) or self._tiled(count, ranges))
+        return count > 0 and (self.one_scan or self._stage3_path(count, ranges) != "scan")
 
     def _fused_offsets(self, pattern, factors, base, n, vertex_counts, index_counts, vertex_offsets,
                        index_offsets, summary=None) -> cl.Event:
