@@ -71,8 +71,8 @@ __kernel void prepared_points(__global const kind_patch *restrict prepared, __gl
  * then the work-group writes the staged points out, consecutive work-items the consecutive
  * points of a line (a patch's rows, and its ring's edges, are side by side in the output), so
  * that the global stores of a warp fall side by side, where a work-item writing its own line
- * (stages/vertex_rows.cl) spreads them over the lines.  Each point is line_point's (stages/rows.h):
- * bitwise what stages/vertices.cl writes.  Patches without vertices (culled) have no lines and
+ * (stages/vertex_rows.cl) spreads them over the lines.  Each point is edge_point's or row_point's
+ * (stages/rows.h): bitwise what stages/vertices.cl writes.  Patches without vertices (culled) have no lines and
  * are never read from prepared[] (prepare_patches skips them); a batch of more than `capacity`
  * vertices writes none (batch_fits: the whole launch returns).  Needs patches_per_group <=
  * LINE_MAX_PATCHES and the work-group size LINE_GROUP (the host's constants, checked by a test). */
@@ -82,6 +82,19 @@ __kernel void prepared_points(__global const kind_patch *restrict prepared, __gl
 #endif
 #define LINE_MAX_PATCHES 64
 #define LINE_STAGED (LINE_GROUP * (LINE_CHUNK + 1))
+
+/* A point's position, normal and uv (its domain point's u, v) to the staging slot. */
+inline void stage_point(__local float (*staged)[LINE_STAGED], uint slot, float3 position, float3 normal, float3 x)
+{
+    staged[0][slot] = position.x;
+    staged[1][slot] = position.y;
+    staged[2][slot] = position.z;
+    staged[3][slot] = normal.x;
+    staged[4][slot] = normal.y;
+    staged[5][slot] = normal.z;
+    staged[6][slot] = x.x;
+    staged[7][slot] = x.y;
+}
 
 __kernel void line_constants(__global uint *constants)
 {
@@ -158,20 +171,20 @@ void prepared_rows(__global const kind_patch *restrict prepared, __global const 
         barrier(CLK_LOCAL_MEM_FENCE);  /* read by all before the next round resets it */
         for (int k = 0; k < length; k += LINE_CHUNK) {
             int staging = clamp(count - k, 0, LINE_CHUNK);
-            for (int s = 0; s < staging; ++s) {
-                patch = prepared[p - first_patch];  /* copied per point: no patch held across the steps */
-                float3 x, position, normal;
-                line_point(&patch, f, collapsed, edge, row, k + s, forward_differencing, &walk, &x, &position,
-                           &normal);
-                uint slot = item * (LINE_CHUNK + 1) + (uint)s;
-                staged[0][slot] = position.x;
-                staged[1][slot] = position.y;
-                staged[2][slot] = position.z;
-                staged[3][slot] = normal.x;
-                staged[4][slot] = normal.y;
-                staged[5][slot] = normal.z;
-                staged[6][slot] = x.x;
-                staged[7][slot] = x.y;
+            uint own = item * (LINE_CHUNK + 1);  /* this work-item's staging slots */
+            float3 x, position, normal;
+            if (edge >= 0) {  /* two loops: each copies only the part of the patch that its points read */
+                for (int s = 0; s < staging; ++s) {
+                    patch = prepared[p - first_patch];  /* copied per point: no patch held across the steps */
+                    edge_point(&patch, f, collapsed, edge, k + s, &x, &position, &normal);
+                    stage_point(staged, own + (uint)s, position, normal, x);
+                }
+            } else {
+                for (int s = 0; s < staging; ++s) {
+                    patch = prepared[p - first_patch];
+                    row_point(&patch, f, row, k + s, forward_differencing, &walk, &x, &position, &normal);
+                    stage_point(staged, own + (uint)s, position, normal, x);
+                }
             }
             line_at[item] = at + (ulong)k;
             line_count[item] = staging;

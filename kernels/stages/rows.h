@@ -133,28 +133,31 @@ ALWAYS_INLINE uint line_start(int4 f, int edge, int row, __private int *count)
     return at;
 }
 
-/* Point k (0 ..) of a line, bitwise what put_ring / put_rows write there: ring point k of edge
- * `edge` as put_ring computes it (the edge loop unrolled as there, so that each copy has its
- * edge's data at constant offsets; a warp whose lanes share the edge runs one copy), or point
- * k + 1 of row `row`, directly or as the next step of `walk` (kind_row_begin'd by the caller,
- * stepped once per point in order, as put_rows does). */
-ALWAYS_INLINE void line_point(__private const kind_patch *patch, int4 f, int collapsed, int edge, int row, int k,
-                              int forward_differencing, __private kind_row *walk, __private float3 *x,
-                              __private float3 *position, __private float3 *normal)
+/* Point k (0 ..) of ring edge `edge`, bitwise what put_ring writes there (the edge loop unrolled
+ * as there, so that each copy has its edge's data at constant offsets; a warp whose lanes share
+ * the edge runs one copy). */
+ALWAYS_INLINE void edge_point(__private const kind_patch *patch, int4 f, int collapsed, int edge, int k,
+                              __private float3 *x, __private float3 *position, __private float3 *normal)
 {
-    if (edge >= 0) {
-        __attribute__((opencl_unroll_hint))
-        for (int e = 0; e < PATTERN_EDGES; ++e)
-            if (e == edge)
-                *position = ring_position(patch, f, collapsed, e, k, x);
-        kind_eval(patch, *x, 0, normal);
-    } else {
-        *x = pattern_row_point(f, row, k + 1);
-        if (forward_differencing)
-            kind_row_next(patch, walk, *x, position, normal);
-        else
-            kind_eval(patch, *x, position, normal);
-    }
+    __attribute__((opencl_unroll_hint))
+    for (int e = 0; e < PATTERN_EDGES; ++e)
+        if (e == edge)
+            *position = ring_position(patch, f, collapsed, e, k, x);
+    kind_eval(patch, *x, 0, normal);
+}
+
+/* Point k + 1 of interior row `row`, bitwise what put_rows writes there: directly, or as the next
+ * step of `walk` (kind_row_begin'd by the caller, stepped once per point in order, as put_rows
+ * does). */
+ALWAYS_INLINE void row_point(__private const kind_patch *patch, int4 f, int row, int k, int forward_differencing,
+                             __private kind_row *walk, __private float3 *x, __private float3 *position,
+                             __private float3 *normal)
+{
+    *x = pattern_row_point(f, row, k + 1);
+    if (forward_differencing)
+        kind_row_next(patch, walk, *x, position, normal);
+    else
+        kind_eval(patch, *x, position, normal);
 }
 
 /* Stage 4 by vertex (stages/vertex_points.cl, prepared_points.cl): a work-group of G work-items
