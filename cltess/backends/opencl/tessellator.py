@@ -63,10 +63,11 @@ PREPARED_WORK = ("vertex-prep", "point-prep", "rows-prep")
 #: one line (an interior row or a ring edge) of the group's patches; the kernel's LINE_GROUP
 #: (kernel line_constants, checked equal by tests/test_work_points.py).
 LINE_GROUP = 64
-#: Patches per work-group of "rows-prep" (a speed setting; at most the kernel's LINE_MAX_PATCHES).
-#: On the H200, uniform level 16: stage 4 0.919 ms at 8, 0.644 at 16, 0.572 at 32 (bench/RESULTS.md,
-#: "Issue 15: stage 4 a work-item per line, session 6").
-LINE_PATCHES = 32
+#: Patches per work-group of "rows-prep" (a speed setting; at most the kernel's LINE_MAX_PATCHES):
+#: on the H200, uniform level 16 (32,000 patches), stage 4 took 0.603 ms at 16, 0.537 at 32 and
+#: 0.512 at 64 (bench/RESULTS.md, "Issue 15: stage 4 a work-item per row or ring edge").  A scene
+#: of few patches gets few work-groups: "rows-prep" is for scenes of large patches.
+LINE_PATCHES = 64
 LINE_MAX_PATCHES = 64
 #: How stages 4-5 spread their work (docs/design.md, "Work distribution"): "patch" a work-item
 #: per patch (stages/vertices.cl, stages/indices.cl); "rows" stage 4 a work-item per (patch,
