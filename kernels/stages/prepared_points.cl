@@ -76,7 +76,7 @@ __kernel void prepared_points(__global const kind_patch *restrict prepared, __gl
  * are never read from prepared[] (prepare_patches skips them); a batch of more than `capacity`
  * vertices writes none (batch_fits: the whole launch returns).  Needs patches_per_group <=
  * LINE_MAX_PATCHES and the work-group size LINE_GROUP (the host's constants, checked by a test). */
-#define LINE_GROUP 64
+#define LINE_GROUP 32
 #ifndef LINE_CHUNK  /* points per line staged at a time (a build option may set it: bench/gpu_stage45.py) */
 #define LINE_CHUNK 16
 #endif

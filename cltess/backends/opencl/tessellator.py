@@ -61,13 +61,15 @@ RECORDS_PER_ITEM_PREPARED = 16
 PREPARED_WORK = ("vertex-prep", "point-prep", "rows-prep")
 #: "rows-prep" (stages/prepared_points.cl prepared_rows): work-items per work-group, each walking
 #: one line (an interior row or a ring edge) of the group's patches; the kernel's LINE_GROUP
-#: (kernel line_constants, checked equal by tests/test_work_points.py).
-LINE_GROUP = 64
-#: Patches per work-group of "rows-prep" (a speed setting; at most the kernel's LINE_MAX_PATCHES):
-#: on the H200, uniform level 16 (32,000 patches), stage 4 took 0.603 ms at 16, 0.537 at 32 and
-#: 0.512 at 64 (bench/RESULTS.md, "Issue 15: stage 4 a work-item per row or ring edge").  A scene
-#: of few patches gets few work-groups: "rows-prep" is for scenes of large patches.
-LINE_PATCHES = 64
+#: (kernel line_constants, checked equal by tests/test_work_points.py).  One warp: on the H100,
+#: uniform level 16, stage 4 took 0.508-0.511 ms with groups of 32 and 32 patches against
+#: 0.539-0.542 with groups of 64 and 64 patches (the same number of warps; a warp waits for no
+#: other at the group's barriers), 0.540 at 32 and 16, 0.771 at 32 and 64 (half the warps:
+#: the SMs not filled) (bench/RESULTS.md, "Issue 15: stage 4 a work-item per row or ring edge").
+LINE_GROUP = 32
+#: Patches per work-group of "rows-prep" (a speed setting; at most the kernel's LINE_MAX_PATCHES).
+#: A scene of few patches gets few work-groups: "rows-prep" is for scenes of large patches.
+LINE_PATCHES = 32
 LINE_MAX_PATCHES = 64
 #: How stages 4-5 spread their work (docs/design.md, "Work distribution"): "patch" a work-item
 #: per patch (stages/vertices.cl, stages/indices.cl); "rows" stage 4 a work-item per (patch,
