@@ -71,11 +71,13 @@ __kernel void prepared_points(__global const kind_patch *restrict prepared, __gl
  * then the work-group writes the staged points out, consecutive work-items the consecutive
  * points of a line (a patch's rows, and its ring's edges, are side by side in the output), so
  * that the global stores of a warp fall side by side, where a work-item writing its own line
- * (stages/vertex_rows.cl) spreads them over the lines.  Each point is edge_point's or row_point's
- * (stages/rows.h): bitwise what stages/vertices.cl writes.  Patches without vertices (culled) have no lines and
- * are never read from prepared[] (prepare_patches skips them); a batch of more than `capacity`
- * vertices writes none (batch_fits: the whole launch returns).  Needs patches_per_group <=
- * LINE_MAX_PATCHES and the work-group size LINE_GROUP (the host's constants, checked by a test). */
+ * (stages/vertex_rows.cl) spreads them over the lines.  Each point is edge_point's or
+ * row_point's (stages/rows.h): bitwise what stages/vertices.cl writes.  Patches without
+ * vertices (culled) have no lines and are never read from prepared[] (prepare_patches skips
+ * them); a batch of more than `capacity` vertices writes none (batch_fits: the whole launch
+ * returns).  Needs patches_per_group <= LINE_MAX_PATCHES and the work-group size LINE_GROUP (the
+ * host's constants, checked by a test).  On the H100, uniform level 16: stage 4 0.505 ms against
+ * prepared_points' 1.07 (bench/RESULTS.md, "Issue 15: stage 4 a work-item per row or ring edge"). */
 #define LINE_GROUP 32
 #ifndef LINE_CHUNK  /* points per line staged at a time (a build option may set it: bench/gpu_stage45.py) */
 #define LINE_CHUNK 16
@@ -141,7 +143,7 @@ void prepared_rows(__global const kind_patch *restrict prepared, __global const 
     for (uint first_line = 0; first_line < lines; first_line += LINE_GROUP) {
         uint line = first_line + item, q = 0;
         int edge = -1, row = 0, count = 0;
-        if (line < rows) {  /* row row of patch q */
+        if (line < rows) {  /* row `row` of patch q */
             while (row_first[q + 1] <= line)
                 ++q;
             row = (int)(line - row_first[q]) + 1;
@@ -173,9 +175,12 @@ void prepared_rows(__global const kind_patch *restrict prepared, __global const 
             int staging = clamp(count - k, 0, LINE_CHUNK);
             uint own = item * (LINE_CHUNK + 1);  /* this work-item's staging slots */
             float3 x, position, normal;
-            if (edge >= 0) {  /* two loops: each copies only the part of the patch that its points read */
+            /* Two loops, each reading only the part of the patch that its points use.  (The copy is
+             * the same in every step, and NVIDIA's compiler loads it once before the loop: 255
+             * registers, bench/RESULTS.md.) */
+            if (edge >= 0) {
                 for (int s = 0; s < staging; ++s) {
-                    patch = prepared[p - first_patch];  /* copied per point: no patch held across the steps */
+                    patch = prepared[p - first_patch];
                     edge_point(&patch, f, collapsed, edge, k + s, &x, &position, &normal);
                     stage_point(staged, own + (uint)s, position, normal, x);
                 }
