@@ -72,7 +72,8 @@ ulong flag_counts(int flag) {{ return (ulong)((flag & FLAG_CULLED) != 0) | ((ulo
 #: The stage 4-5 programs of a work distribution other than a patch per work-item
 #: (tessellator.py WORK_DISTRIBUTIONS).
 WORK_STAGES = {"rows": ("vertex_rows",), "vertex": ("vertex_points",), "point": ("vertex_points", "triangles"),
-               "vertex-prep": ("prepared_points",), "point-prep": ("prepared_points", "triangles")}
+               "vertex-prep": ("prepared_points",), "point-prep": ("prepared_points", "triangles"),
+               "rows-prep": ("prepared_points", "triangles")}
 
 
 class Kernel:
