@@ -180,32 +180,3 @@ def triangle_ratio(net: np.ndarray, radius: float, corners: np.ndarray, toleranc
         stack += [(np.array(q_lo), np.array(q_hi), level + 1) for q_lo, q_hi in quarters if meets(q_lo, q_hi, corners)]
     return worst
 
-
-def exact_bound(net: np.ndarray, corners: np.ndarray, depth: int = DEPTH) -> float:
-    """The error hull without any rounding allowance (float64), each box halved while that lowers
-    the bound, to ``depth``: max over the kept boxes of max_k |E_k| / W_k (for tests and benches:
-    how much the allowances add)."""
-    corners = np.asarray(corners, float)
-    values = np.array([point(net, x) for x in corners])
-
-    def plain(lo, hi):
-        restricted = np.einsum("bj,ai,jic->bac", restriction(lo[1], hi[1]), restriction(lo[0], hi[0]),
-                               net.reshape(4, 4, 4).astype(float))
-        linear = np.array([affine(y, corners, values)[0]
-                           for y in ((lo[0], lo[1]), (hi[0], lo[1]), (lo[0], hi[1]), (hi[0], hi[1]))]).reshape(2, 2, 3)
-        wl = sum(np.outer([_alpha(b, d) for b in range(5)], [_alpha(a, c) for a in range(5)])[..., None]
-                 * np.pad(restricted[..., 3:] * linear[d, c], ((d, 1 - d), (c, 1 - c), (0, 0)))
-                 for d in range(2) for c in range(2))
-        return float((np.linalg.norm(elevated(restricted[..., :3]) - wl, axis=-1) / elevated(restricted[..., 3])).max())
-
-    def refine(lo, hi, level):
-        here = plain(lo, hi)
-        if level == depth:
-            return here
-        mid = (lo + hi) / 2
-        quarters = [((lo[0], lo[1]), (mid[0], mid[1])), ((mid[0], lo[1]), (hi[0], mid[1])),
-                    ((lo[0], mid[1]), (mid[0], hi[1])), ((mid[0], mid[1]), (hi[0], hi[1]))]
-        parts = [refine(np.array(a), np.array(b), level + 1) for a, b in quarters if meets(a, b, corners)]
-        return min(here, max(parts)) if parts else here
-
-    return refine(corners.min(axis=0), corners.max(axis=0), 0)
