@@ -22,7 +22,6 @@ from __future__ import annotations
 import time
 
 import numpy as np
-import pyopencl as cl
 import pyopencl.array as cl_array
 
 from ...criteria.integral import (SUBDIVISIONS, SUBPATCH_LEVELS, TRIAL_SCALES, graded_breaks, scene_pyramids, table_cells,
