@@ -342,6 +342,14 @@ def integral_bound():
     return height_grid(bumps(2, 1, [[0.3, 1.2]]), weights, name="rational pair"), dict(eps=0.8, bound="integral")
 
 
+def error_hull_bound():
+    """The same rational pair under Request(bound="error-hull"): the trials, the error_hull_bound
+    kernel (boxes halved and dropped, the per-patch early stop) on every emitted triangle,
+    transition triangles included, then the final emission."""
+    scene, options = integral_bound()
+    return scene, dict(options, eps=0.2, bound="error-hull")
+
+
 SCENARIOS = {
     "uniform": uniform,
     "uniform_fine": uniform_fine,
@@ -375,6 +383,7 @@ SCENARIOS = {
     "esc_levels_strips": esc_levels_strips,
     "esc_sphere_poles": esc_sphere_poles,
     "integral_bound": integral_bound,
+    "error_hull_bound": error_hull_bound,
 }
 
 #: Scenarios whose tessellation is then measured on the device (Tessellator.verify,

@@ -316,6 +316,9 @@ class Tessellator:
         if request.bound == "integral":  # tighter factors, certified triangle by triangle
             from .integral import plan_integral
             return plan_integral(self, scene, request, started)
+        if request.bound == "error-hull":  # tighter factors, certified triangle by triangle
+            from .error_hull import plan_error_hull
+            return plan_error_hull(self, scene, request, started)
         return self.plan_on(self.scene_data(scene, request.sharp_edges), request, started)
 
     def compose(self, scene: Scene, request: Request) -> None:
@@ -343,6 +346,8 @@ class Tessellator:
             self.programs.summary_scan()
         if request.bound == "integral":
             self.programs.kernel("integral_bound")
+        if request.bound == "error-hull":
+            self.programs.kernel("error_hull_bound")
 
     def scene_data(self, scene: Scene, sharp_edges: str = "straight") -> "SceneData":
         """What stays on the device for a scene whatever the tolerance or camera: every kind's
