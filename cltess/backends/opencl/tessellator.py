@@ -195,6 +195,12 @@ def _record_groups(records: int, per_item: int) -> tuple[int]:
     return (max(1, -(-records // per_group)) * WORK_GROUP,)
 
 
+#: Where stage 1's tolerance arguments (``kernel_args()`` of ObjectSpace, ScreenSpace) sit among
+#: its kernel's (stage_factors_of, stages/factors.cl): the only arguments of a Session frame's
+#: launches that change with the camera (recorded.py).
+TOLERANCE_ARGUMENTS = slice(4, 9)
+
+
 def wait_ms(events) -> float:
     """Wait for events; the host milliseconds spent blocked (a frame's wall_ms["waits"])."""
     started = time.perf_counter()
@@ -646,10 +652,10 @@ class Tessellator:
         pattern: the kind's own unless given; a dyadic one rounds the factors to 2^p_e,
         p_e <= max_level."""
         count = len(data["source"])
+        arguments = (data["source"].data, data["controls"].data, np.uint32(count), np.uint32(patch_base),
+                     *tolerance.kernel_args(), np.int32(max_factor), np.int32(max_level), factors.data, flags.data)
         event = self.programs.kernel("factors", kind=kind, tolerance=tolerance, pattern=pattern or kind.pattern)(
-            self.queue, _global_size(count), None, data["source"].data, data["controls"].data, np.uint32(count),
-            np.uint32(patch_base), *tolerance.kernel_args(), np.int32(max_factor), np.int32(max_level),
-            factors.data, flags.data)
+            self.queue, _global_size(count), None, *arguments)
         return [event]
 
     def stage_crack_free(self, factors, groups, crack="crack/max.h", out=None):
