@@ -13,6 +13,10 @@ What a ``Session`` keeps between calls, so that a frame costs only the five stag
 * the output buffers (``OutputBuffers``), grown only when a frame needs more, and on a GPU the
   page-locked host buffers its read-back goes through.
 
+A frame for a new camera alone enqueues the launches of the last frame recorded for the
+session's request again, with stage 1's camera arguments replaced (``RecordedFrame``,
+cltess/backends/opencl/recorded.py): no kernel look-up, path choice or argument set-up.
+
 A frame does not wait for stage 3's totals before it enqueues stages 4-5: they run on the
 buffers' capacity, and write nothing if the frame's output does not fit (``batch_fits`` in
 kernels/common.h).  The host reads the totals when the frame's sizes, arrays or times are
