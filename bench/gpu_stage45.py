@@ -14,7 +14,7 @@ Uniform level 16 (``frame_loop.teapots``: 1,000 teapots, 32,000 patches, every e
   kernel of this output can reach (median of ``--repeat``);
 * **variants**: each in a child process (the engine's programs are built once per process),
   ``WORK`` a work distribution as ``frame_loop.py --work`` takes it ("point-prep",
-  "point-prep/8", ":direct"), ``TREE`` the source tree it runs from ("." this one; another
+  "point-prep/8", ":direct"; "rows-prep/8": 8 patches per work-group of stage 4), ``TREE`` the source tree it runs from ("." this one; another
   ``git archive`` for a before/after in the same run), ``OPTIONS`` extra compiler options
   (``CLTESS_BUILD_OPTIONS``; "-" none; written ``opt:-DX=1`` so that argparse takes it as a
   value), e.g. ``opt:-DSTAGE4_RELOAD=1`` to pick a kernel variant.
@@ -57,7 +57,10 @@ def child(args) -> dict:
     spec, _, evaluation = args.work.partition(":")
     work, _, per_item = spec.partition("/")
     tessellator = Tessellator(args.device, work=work)
-    tessellator.records_per_item = int(per_item) if per_item else None
+    if work == "rows-prep":  # "rows-prep/8": patches per work-group of stage 4
+        tessellator.patches_per_group = int(per_item) if per_item else None
+    else:
+        tessellator.records_per_item = int(per_item) if per_item else None
     scene = frame_loop.teapots(args.copies)
     request = dict(frame_loop.uniform_request(16), forward_differencing=evaluation != "direct")
     session = cltess.Session(scene, tessellator=tessellator, **request)
@@ -80,7 +83,7 @@ def child(args) -> dict:
         from cltess.kinds import BEZIER
         record["registers"] = {}
         stages = {"point": ("vertex_points", "triangles"), "point-prep": ("prepared_points", "triangles"),
-                  "patch": ("vertices", "indices")}.get(work, ())
+                  "rows-prep": ("prepared_points", "triangles"), "patch": ("vertices", "indices")}.get(work, ())
         for stage in stages:
             headers, defines = programs_module.composition(stage, kind=BEZIER, pattern=BEZIER.pattern)
             source, options = programs_module.program_text(stage, headers, defines)

@@ -201,8 +201,8 @@ def main(argv=None) -> None:
     parser.add_argument("--no-occ", action="store_true", help="cltess only (e.g. to compare two versions)")
     parser.add_argument("--baseline", type=Path, help="a --json of another cltess version: its rows too")
     parser.add_argument("--baseline-label", default="baseline")
-    parser.add_argument("--bound", choices=("hull", "integral"), default="hull",
-                        help="cltess's Request.bound (integral: docs/rational-bound.md)")
+    parser.add_argument("--bound", choices=("hull", "integral", "error-hull"), default="hull",
+                        help="cltess's Request.bound (integral, error-hull: docs/rational-bound.md)")
     args = parser.parse_args(argv)
     baseline = json.loads(args.baseline.read_text()) if args.baseline else None
 

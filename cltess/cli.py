@@ -236,11 +236,12 @@ def build_parser() -> argparse.ArgumentParser:
                              "edges snapped to their own dyadic level; factors rounded up to powers of two), or esc "
                              "(Bezier patches: Hu et al. 2014's distance test on the candidates of a level-L "
                              "pattern, docs/esc.md)")
-    shared.add_argument("--bound", choices=("hull", "integral"), default="hull",
-                        help="rational Bezier patches: hull (default) takes the hull bound's factors; integral "
-                             "tries smaller ones and bounds every emitted triangle by the integral form of the "
-                             "remainder, keeping the smallest that pass (fewer triangles, slower; "
-                             "docs/rational-bound.md; transition pattern only)")
+    shared.add_argument("--bound", choices=("hull", "integral", "error-hull"), default="hull",
+                        help="Bezier patches: hull (default) takes the hull bound's factors; integral (rational "
+                             "patches) and error-hull (all) try smaller ones and bound every emitted triangle, by the "
+                             "integral form of the remainder or by the Bernstein net of the error itself, keeping "
+                             "the smallest that pass (fewer triangles, slower; docs/rational-bound.md; transition "
+                             "pattern only)")
     shared.add_argument("--max-level", type=_max_level, default=6, metavar="L",
                         help="semi-uniform: the largest level (edge factor 2^L; default 6); a patch that "
                              "needs more is saturated.  esc: the candidate level L (L+1 steps per coarse edge, "
@@ -551,7 +552,7 @@ def _progress(args, what: str):
 def cmd_tessellate(args) -> int:
     """Load, tessellate, export, summarise."""
     if args.camera_path is not None or args.silhouette is not None:
-        _level_options(args, None)  # refuses --bound integral
+        _level_options(args, None)  # refuses --bound integral and error-hull
         return cmd_tessellate_frames(args)
     from cltess.device import pick_device
     from cltess.io.export import estimate_output_bytes, estimate_write_seconds
@@ -726,15 +727,17 @@ def cmd_render(args) -> int:
 
 def _level_options(args, scene) -> dict:
     """The SD-2 level-function options of a run (none unless --pattern sd2 or --level-function),
-    and --bound integral."""
+    and --bound integral or error-hull."""
     if args.level_function is not None and args.pattern == "transition":
         args.pattern = "sd2"  # --level-function implies it (transition is only the default)
-    if args.bound == "integral" and (args.pattern != "transition" or getattr(args, "camera_path", None) is not None
-                                     or getattr(args, "silhouette", None) is not None):
-        raise UsageError("--bound integral scales the transition pattern's factors once per run: it cannot be "
+    from cltess.request import TRIAL_BOUNDS
+
+    if args.bound in TRIAL_BOUNDS and (args.pattern != "transition" or getattr(args, "camera_path", None) is not None
+                                       or getattr(args, "silhouette", None) is not None):
+        raise UsageError(f"--bound {args.bound} scales the transition pattern's factors once per run: it cannot be "
                          "used with --pattern other than transition, --level-function, --camera-path or --silhouette")
     if args.pattern != "sd2":
-        return {"bound": "integral"} if args.bound == "integral" else {}
+        return {"bound": args.bound} if args.bound in TRIAL_BOUNDS else {}
     return {"level_function": args.level_function, "level_factors": tuple(args.level_factors),
             "depth_map": args.depth_map, "silhouette_band": args.silhouette_band}
 

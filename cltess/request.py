@@ -17,9 +17,12 @@ from .patterns.semi_uniform import DEFAULT_MAX_LEVEL
 
 #: The largest max_level: 2^level within the kernels' factor limit (cltess.limits.MAX_FACTOR).
 MAX_LEVEL = MAX_FACTOR.bit_length() - 1
-#: Request.bound's values: the hull bound's factors (docs/rational-bound.md), or tighter ones for
-#: rational Bézier patches certified triangle by triangle by the integral form of the remainder.
-BOUNDS = ("hull", "integral")
+#: Request.bound's values: the hull bound's factors (docs/rational-bound.md), or tighter ones
+#: certified triangle by triangle: rational Bézier patches by the integral form of the remainder,
+#: or every Bézier patch by the error hull (Bernstein net of p - l).
+BOUNDS = ("hull", "integral", "error-hull")
+#: The bounds that scale the transition pattern's factors by trials (plan_trials).
+TRIAL_BOUNDS = ("integral", "error-hull")
 #: Request.emit's values: stages 4-5 per patch, or by level (cltess/backends/opencl/levels.py).
 EMIT_MODES = ("per_patch", "by_level")
 from .scene import Camera, Scene
@@ -56,9 +59,12 @@ class Request:
                     the ramp from high (at the silhouette) to low; continuous in the view for
                     band > 0 (default 0.25), the paper's two classes (which pop) for 0.
     camera:         the camera of "depth" and "silhouette" (None: the scene's).
-    bound:          "hull" (stage 1's factors) or "integral": rational Bézier patches try smaller
+    bound:          "hull" (stage 1's factors), "integral": rational Bézier patches try smaller
                     factors, each emitted triangle bounded by the integral form of the remainder
-                    (cltess/backends/opencl/integral.py; OpenCL backend, integer patterns only).
+                    (cltess/backends/opencl/integral.py), or "error-hull": every Bézier patch
+                    tries smaller factors, each emitted triangle bounded by the Bernstein net of
+                    its error (cltess/backends/opencl/error_hull.py); OpenCL backend, integer
+                    patterns only.
     """
 
     tolerance: ObjectSpace | ScreenSpace
@@ -110,8 +116,8 @@ class Request:
             raise ValueError(f"depth_range must be (near, far) with near < far, got {self.depth_range!r}")
         if self.bound not in BOUNDS:
             raise ValueError(f"bound must be one of {', '.join(BOUNDS)}, got {self.bound!r}")
-        if self.bound == "integral" and (self.level_function is not None or self.pattern not in (None, "transition", "quad_transition")):
-            raise ValueError(f"bound 'integral' scales the transition pattern's factors; it cannot be used with "
+        if self.bound in TRIAL_BOUNDS and (self.level_function is not None or self.pattern not in (None, "transition", "quad_transition")):
+            raise ValueError(f"bound {self.bound!r} scales the transition pattern's factors; it cannot be used with "
                              f"pattern {self.pattern or 'sd2'!r}")
         if not (isinstance(self.silhouette_band, numbers.Real) and 0 <= self.silhouette_band <= 2):
             raise ValueError(f"silhouette_band must be a number in 0..2 (a cosine range), got {self.silhouette_band!r}")

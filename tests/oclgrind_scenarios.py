@@ -104,6 +104,13 @@ def uniform():
     return height_grid(heights), dict(eps=0.01)
 
 
+def uniform_fine():
+    """The uniform patch at factors above 16: stage 4 by line (prepared_rows) stages its rows and
+    edges in more than one chunk of LINE_CHUNK points."""
+    scene, _ = uniform()
+    return scene, dict(eps=0.0005, max_factor=24)
+
+
 def one_transition():
     """A mildly curved patch next to a strongly curved one: its shared edge is raised."""
     return height_grid(bumps(2, 1, [[0.3, 2.0]])), dict(eps=0.01)
@@ -335,8 +342,17 @@ def integral_bound():
     return height_grid(bumps(2, 1, [[0.3, 1.2]]), weights, name="rational pair"), dict(eps=0.8, bound="integral")
 
 
+def error_hull_bound():
+    """The same rational pair under Request(bound="error-hull"): the trials, the error_hull_bound
+    kernel (boxes halved and dropped, the per-patch early stop) on every emitted triangle,
+    transition triangles included, then the final emission."""
+    scene, options = integral_bound()
+    return scene, dict(options, eps=0.2, bound="error-hull")
+
+
 SCENARIOS = {
     "uniform": uniform,
+    "uniform_fine": uniform_fine,
     "one_transition": one_transition,
     "flat_next_to_curved": flat_next_to_curved,
     "two_transitions_adjacent": two_transitions_adjacent,
@@ -367,6 +383,7 @@ SCENARIOS = {
     "esc_levels_strips": esc_levels_strips,
     "esc_sphere_poles": esc_sphere_poles,
     "integral_bound": integral_bound,
+    "error_hull_bound": error_hull_bound,
 }
 
 #: Scenarios whose tessellation is then measured on the device (Tessellator.verify,
@@ -432,7 +449,16 @@ POINTS = {"uniform_by_points": "uniform", "pn_icosphere_by_points": "pn_icospher
 PREPARED_POINTS = {"uniform_by_prepared_points": "uniform", "pn_icosphere_by_prepared_points": "pn_icosphere",
                    "mixed_culled_by_prepared_points": "mixed_culled",
                    "many_patches_batched_by_prepared_points": ("many_patches", 4096)}
+#: Stage 4 a work-item per row or ring edge (Tessellator(work="rows-prep"): stages/prepared_points.cl
+#: prepare_patches and prepared_rows, points staged in local memory; stage 5 as "point"): lines
+#: longer than a staged chunk, PN (three edges), culled patches and two kinds, direct evaluation
+#: with collapsed edges, several work-groups and batches; also in POINTS (bitwise checks).
+PREPARED_ROWS = {"uniform_fine_by_prepared_rows": "uniform_fine", "pn_icosphere_by_prepared_rows": "pn_icosphere",
+                 "mixed_culled_by_prepared_rows": "mixed_culled",
+                 "collapsed_bottom_direct_by_prepared_rows": "collapsed_bottom_direct",
+                 "many_patches_batched_by_prepared_rows": ("many_patches", 4096)}
 POINTS.update(PREPARED_POINTS)
+POINTS.update(PREPARED_ROWS)
 #: Session frames (cltess.Session) whose second frame does not fit the first one's buffers:
 #: stages 4-5 launched on the buffers' capacity write nothing (batch_fits, kernels/common.h),
 #: then run again on grown buffers (issue 15, docs/design.md section 11); per patch and per point.
@@ -598,7 +624,7 @@ def run_scenario(name: str, tessellator, out_dir: Path) -> dict:
         scene, options = SCENARIOS[base]()
         saved = tessellator.work
         # before the plan: its programs (and the prep scratch buffer) are made before any buffer
-        tessellator.work = "point-prep" if name in PREPARED_POINTS else "point"
+        tessellator.work = "point-prep" if name in PREPARED_POINTS else "rows-prep" if name in PREPARED_ROWS else "point"
         try:
             if cap is None:
                 plan = tessellator.plan(scene, **options)

@@ -191,6 +191,10 @@ def test_scenarios_reach_every_code_path(oclgrind, tmp_path_factory):
     ring = factors["integral_bound"]
     assert integral["integral_rounds"] >= 2 and integral["integral_checked"] > 0
     assert ((ring[:, 0] != ring[:, 2]) | (ring[:, 1] != ring[:, 3])).any(), "integral: transition triangles"
+    hull = stats["error_hull_bound"]  # stages/error_hull_bound.cl ran, and a trial was taken back
+    ring = factors["error_hull_bound"]
+    assert hull["error_hull_rounds"] >= 2 and hull["error_hull_checked"] > 0
+    assert ((ring[:, 0] != ring[:, 2]) | (ring[:, 1] != ring[:, 3])).any(), "error hull: transition triangles"
     for name in scenarios.VERIFIED:  # stages/verify.cl ran, and measured something
         assert 0.0 < run.results[name]["verify_ratio"] < 1.0, name
 

@@ -1,14 +1,20 @@
 """Stages 4-5 a work-item per output vertex and per output triangle (stages/vertex_points.cl,
-stages/triangles.cl, Tessellator(work="point")): bitwise the per-patch kernels' output, forward
-differencing included (replayed per vertex), for every kind and pattern, in batches, with
-collapsed edges (issue 15)."""
+stages/triangles.cl, Tessellator(work="point")), from prepared patches ("point-prep"), and stage 4
+a work-item per row or ring edge ("rows-prep"): bitwise the per-patch kernels' output, forward
+differencing included, for every kind and pattern, in batches, with collapsed edges (issue 15)."""
 from pathlib import Path
 
 import numpy as np
+import pyopencl as cl
 import pytest
+from support import as_float32, random_patches
+from support.factors import random_factors
+from test_vertices import FD_POSITION_TOLERANCE, device_vertices
 
+from cltess import reference
 from cltess.backends.opencl import tessellator as opencl
 from cltess.io import load_scene
+from cltess.kinds import BEZIER
 from cltess.tessellation import HOST_FIELDS
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
@@ -124,3 +130,77 @@ def test_prepared_points_in_batches_and_with_a_grown_scratch_buffer(tessellator)
     whole = per_patch.tessellate(scene, pixels=0.5)
     same_in_batches(by_prepared, scene, whole)
     assert by_prepared._prepared.size >= by_prepared._kind_patch_sizes[("bezier", "patterns/quad_transition.h")]
+
+
+# --- stage 4 a work-item per line (stages/prepared_points.cl prepared_rows, work="rows-prep") ---
+
+@pytest.fixture(scope="module")
+def by_lines(tessellator):
+    return opencl.Tessellator(tessellator.device, work="rows-prep")
+
+
+@pytest.mark.parametrize("patches_per_group", [1, 3, opencl.LINE_PATCHES, opencl.LINE_MAX_PATCHES])
+@pytest.mark.parametrize("name, options", CASES)
+def test_lines_are_bitwise_the_per_patch_kernels(tessellator, by_lines, name, options, patches_per_group):
+    """Rows walked in order and ring edges, staged in local memory: the same bits as the
+    per-patch kernel, forward differencing and direct, every kind and pattern, whatever the
+    patches per work-group (1: rounds of a few lines; 64: lines of many patches per round)."""
+    by_lines.patches_per_group = patches_per_group
+    scene = load_scene(SCENES / name)
+    expected = opencl.Tessellator(tessellator.device, work="patch").tessellate(scene, **options)
+    got = by_lines.tessellate(scene, **options)
+    if options.get("pattern") == "esc" and not np.allclose(np.linalg.norm(expected.normals, axis=1), 1, atol=1e-5):
+        # the per-patch ESC kernel's normals on Intel's CPU runtime (see above)
+        same(opencl.Tessellator(tessellator.device, work="point").tessellate(scene, **options), got)
+    else:
+        same(expected, got)
+
+
+@pytest.mark.parametrize("forward_differencing", [False, True], ids=["direct", "fd"])
+def test_lines_match_the_reference_on_random_patches(tessellator, by_lines, rng, forward_differencing):
+    """Random rational patches and factors (transitions, uniform, culled, all 1; lines longer than
+    a staged chunk): bitwise the per-patch kernel, and within the per-patch kernel's tolerances
+    of the NumPy reference (tests/test_vertices.py)."""
+    patches = random_patches(rng, 300, spread=1.0)
+    factors = random_factors(rng, 300, high=70)
+    assert (factors == 0).all(axis=1).any() and factors.max() > 2 * 16
+    by_lines.patches_per_group = 5
+    per_patch = opencl.Tessellator(tessellator.device, work="patch")
+    expected = device_vertices(per_patch, patches, factors, forward_differencing)
+    got = device_vertices(by_lines, patches, factors, forward_differencing)
+    for field in expected:
+        assert np.array_equal(expected[field], got[field]), field
+    numpy = reference.tessellate(as_float32(patches), factors, (np.arange(300) * 7 % 5))
+    assert np.array_equal(got["patch_ids"], numpy["patch_ids"])
+    assert np.array_equal(got["object_ids"], numpy["object_ids"])
+    assert np.abs(got["uv"] - numpy["uv"]).max() < 1e-6
+    scale = np.abs(patches[..., :3] / patches[..., 3:]).max()
+    tolerance = (2e-6 if not forward_differencing else FD_POSITION_TOLERANCE) * scale
+    assert np.abs(got["positions"] - numpy["positions"]).max() < tolerance
+    assert np.allclose(np.linalg.norm(got["normals"], axis=1), 1, atol=1e-5)
+
+
+def test_lines_in_batches(tessellator, by_lines):
+    """Batches start mid-scene and at a kind's boundary (the tea table's Bézier and PN parts)."""
+    by_lines.patches_per_group = opencl.LINE_PATCHES
+    scene = load_scene(SCENES / "tea_table.json")
+    whole = opencl.Tessellator(tessellator.device, work="patch").tessellate(scene, pixels=0.5)
+    same_in_batches(by_lines, scene, whole)
+
+
+def test_line_constants_are_the_hosts(tessellator, by_lines):
+    """The work-group size and the patches-per-group cap of prepared_rows are the host's, and a
+    cap beyond the kernel's local arrays is refused."""
+    constants = np.zeros(3, np.uint32)
+    buffer = cl.Buffer(by_lines.context, cl.mem_flags.READ_WRITE, constants.nbytes)
+    by_lines.programs.kernel("prepared_points", "line_constants", kind=BEZIER, pattern=BEZIER.pattern)(
+        by_lines.queue, (1,), None, buffer)
+    cl.enqueue_copy(by_lines.queue, constants, buffer)
+    assert (constants[0], constants[2]) == (opencl.LINE_GROUP, opencl.LINE_MAX_PATCHES)
+    assert constants[1] >= 1
+    by_lines.patches_per_group = opencl.LINE_MAX_PATCHES + 1
+    try:
+        with pytest.raises(ValueError, match="patches_per_group"):
+            by_lines.tessellate(load_scene(SCENES / "sphere.bpt"), eps=1e-3)
+    finally:
+        by_lines.patches_per_group = None

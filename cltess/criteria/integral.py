@@ -418,9 +418,10 @@ def triangle_bound(pyramid: np.ndarray, levels: int, corners: np.ndarray, tolera
 
 # --- the trials (the host loop: cltess/backends/opencl/integral.py) -------------------------------
 
-def trial_factors(factors: np.ndarray, trials: np.ndarray) -> np.ndarray:
+def trial_factors(factors: np.ndarray, trials: np.ndarray, scales=TRIAL_SCALES) -> np.ndarray:
     """(P, 4) int32: stage 1's factors ``factors`` (today's, (m, n, m, n) for a quad) scaled by
-    TRIAL_SCALES[trials] and rounded up, at least 1; 0 (culled) stays 0.  Never above today's."""
-    scales = np.asarray(TRIAL_SCALES)[trials][:, None]
+    scales[trials] (TRIAL_SCALES unless given) and rounded up, at least 1; 0 (culled) stays 0.
+    Never above today's."""
+    scales = np.asarray(scales)[trials][:, None]
     scaled = np.ceil(factors * scales - 1e-9).astype(np.int32)
     return np.where(factors > 0, np.clip(scaled, 1, factors), factors).astype(np.int32)

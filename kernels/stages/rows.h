@@ -113,6 +113,53 @@ ALWAYS_INLINE void put_point(__private const kind_patch *patch, int4 f, int coll
     put_vertex(out, at, position, normal, x.xy, p, object);
 }
 
+/* Stage 4 by line (stages/prepared_points.cl prepared_rows): a patch's lines are its interior
+ * rows j = 1 .. pattern_rows(f) and its ring edges e = 0 .. PATTERN_EDGES - 1, each a run of
+ * points side by side in the output.  line_start: the first point's slot in the patch's layout
+ * (patterns/layout.h: the ring, edge by edge, then the rows) and its point count. */
+ALWAYS_INLINE uint line_start(int4 f, int edge, int row, __private int *count)
+{
+    uint at = 0;
+    for (int e = 0; e < PATTERN_EDGES; ++e)
+        if (edge < 0 || e < edge)
+            at += (uint)PATTERN_EDGE_POINTS(f, e);
+    if (edge >= 0) {
+        *count = PATTERN_EDGE_POINTS(f, edge);
+        return at;
+    }
+    for (int j = 1; j < row; ++j)
+        at += (uint)(pattern_row(f, j) - 1);
+    *count = pattern_row(f, row) - 1;
+    return at;
+}
+
+/* Point k (0 ..) of ring edge `edge`, bitwise what put_ring writes there (the edge loop unrolled
+ * as there, so that each copy has its edge's data at constant offsets; a warp whose lanes share
+ * the edge runs one copy). */
+ALWAYS_INLINE void edge_point(__private const kind_patch *patch, int4 f, int collapsed, int edge, int k,
+                              __private float3 *x, __private float3 *position, __private float3 *normal)
+{
+    __attribute__((opencl_unroll_hint))
+    for (int e = 0; e < PATTERN_EDGES; ++e)
+        if (e == edge)
+            *position = ring_position(patch, f, collapsed, e, k, x);
+    kind_eval(patch, *x, 0, normal);
+}
+
+/* Point k + 1 of interior row `row`, bitwise what put_rows writes there: directly, or as the next
+ * step of `walk` (kind_row_begin'd by the caller, stepped once per point in order, as put_rows
+ * does). */
+ALWAYS_INLINE void row_point(__private const kind_patch *patch, int4 f, int row, int k, int forward_differencing,
+                             __private kind_row *walk, __private float3 *x, __private float3 *position,
+                             __private float3 *normal)
+{
+    *x = pattern_row_point(f, row, k + 1);
+    if (forward_differencing)
+        kind_row_next(patch, walk, *x, position, normal);
+    else
+        kind_eval(patch, *x, position, normal);
+}
+
 /* Stage 4 by vertex (stages/vertex_points.cl, prepared_points.cl): a work-group of G work-items
  * owns G * per_item consecutive vertices of the batch (patches first_patch .. first_patch +
  * num_patches - 1), and in step k its work-item l writes vertex k G + l of them, so each step's

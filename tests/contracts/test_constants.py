@@ -85,3 +85,11 @@ def test_the_sd2_zone_constants_equal_the_mirrors():
     found = defines("patterns/sd2.h")
     assert np.float32(found["SD2_CENTRE_FLOOR"]) == np.float32(sd2.CENTRE_FLOOR)
     assert found["SD2_HINT_SHIFT"] == sd2.HINT_SHIFT
+
+
+def test_the_error_hull_constants_equal_the_mirror():
+    from cltess.criteria import error_hull
+
+    found = defines("criteria/error_hull.h")
+    for name in ("DEPTH", "UNIT", "NET_STEPS", "WEIGHT_STEPS", "POINT_STEPS", "MEET_WIDENING", "CONDITION"):
+        assert np.float32(found[f"ERROR_HULL_{name}"]) == np.float32(getattr(error_hull, name)), name

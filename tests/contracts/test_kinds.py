@@ -8,7 +8,7 @@ import pytest
 
 from cltess.criteria import ObjectSpace
 from cltess.kinds import KINDS
-from cltess.request import Request
+from cltess.request import BOUNDS, Request
 from support import bound_ratio, weld_exact
 from support.kinds import closed_scene, random_source
 
@@ -63,6 +63,18 @@ def test_closed_surfaces_are_watertight_and_within_the_bound(tessellator, rng, k
     tess = tessellator.tessellate(scene, Request.of(eps=eps, forward_differencing=fd))
     assert len(np.unique(tess.factors[:, :kind.edges])) > 1  # neighbours with different factors met
     assert tess.stats["saturated"] == 0
+    welded = weld_exact(tess.positions, tess.triangles)
+    assert welded.is_watertight and welded.is_winding_consistent
+    controls, _, _ = kind.reference_factors(kind.prepare(scene).source, ObjectSpace(eps), 64)
+    assert bound_ratio(controls, tess, eps, surface=kind.surface.surface_points) <= 1.0
+
+
+@pytest.mark.parametrize("bound", BOUNDS)
+def test_closed_surfaces_are_watertight_and_within_the_bound_under_every_bound(tessellator, rng, kind, bound):
+    """Request.bound changes the factors (per-triangle certified trials), never the crack-free
+    contract: shared boundary points bitwise equal, and the mesh within eps."""
+    scene, eps = closed_scene(rng, kind)
+    tess = tessellator.tessellate(scene, Request.of(eps=eps, bound=bound))
     welded = weld_exact(tess.positions, tess.triangles)
     assert welded.is_watertight and welded.is_winding_consistent
     controls, _, _ = kind.reference_factors(kind.prepare(scene).source, ObjectSpace(eps), 64)

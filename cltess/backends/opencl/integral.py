@@ -22,7 +22,6 @@ from __future__ import annotations
 import time
 
 import numpy as np
-import pyopencl as cl
 import pyopencl.array as cl_array
 
 from ...criteria.integral import (SUBDIVISIONS, SUBPATCH_LEVELS, TRIAL_SCALES, graded_breaks, scene_pyramids, table_cells,
@@ -90,12 +89,44 @@ def triangle_ratios(tessellator, pyramids, pyramid_of, check, uv, patch_ids, tri
 
 
 def plan_integral(tessellator, scene, request, started: float):
-    """The integral-bound loop (module docstring); returns the final Plan, whose stats carry
-    "integral_rounds", "integral_checked" (triangle bounds evaluated), "integral_at_hull"
-    (rational patches left at today's factors), "integral_patches" (rational patches) and
-    "integral_ms" (host wall time of the loop beyond the first plan)."""
+    """The integral-bound loop (module docstring, ``plan_trials``); returns the final Plan, whose
+    stats carry "integral_rounds", "integral_checked" (triangle bounds evaluated),
+    "integral_at_hull" (rational patches left at today's factors), "integral_patches" (rational
+    patches) and "integral_ms" (host wall time of the loop beyond the first plan)."""
+    uploaded = {}
+
+    def prepare():
+        pyramids, pyramid_of_bezier, rational = integral_pyramids(tessellator, scene)
+        return rational, (pyramids, pyramid_of_bezier)
+
+    def ratios_of(tables, check, tess, triangles, tolerances):
+        pyramids, pyramid_of_bezier = tables
+        if "pyramid_of" not in uploaded:  # every patch's, Bézier patches first
+            pyramid_of = np.full(len(check), -1, np.int32)
+            pyramid_of[:len(pyramid_of_bezier)] = pyramid_of_bezier.get()
+            uploaded["pyramid_of"] = cl_array.to_device(tessellator.queue, pyramid_of)
+        pyramid_of = uploaded["pyramid_of"]
+        return triangle_ratios(tessellator, pyramids, pyramid_of, check, tess.uv, tess.patch_ids, triangles,
+                               tolerances, levels=SUBPATCH_LEVELS, skip_failed=True, worst_of_patch=True)
+
+    plan = plan_trials(tessellator, scene, request, started, "integral", TRIAL_SCALES, JUMP_POWER, prepare, ratios_of)
+    plan.integral_trials = plan.trials
+    return plan
+
+
+def plan_trials(tessellator, scene, request, started: float, name: str, scales, jump_power: float,
+                prepare, ratios_of):
+    """The trial loop of a per-triangle bound (module docstring, steps 1-4) with trial scales
+    ``scales`` (the last 1.0: today's factors).  prepare() -> ((P_bezier,) bool: the Bézier
+    patches to try, the bound's device data); ratios_of(data, check (P,), tess, triangles (T, 3)
+    uint32, tolerances on the device) -> ((T,) bound / tolerance, (P,) the worst of each checked
+    patch).  Returns the final Plan, with ``trials`` (P,) and the stats "<name>_rounds",
+    "<name>_checked" (triangle bounds evaluated), "<name>_at_hull" (tried patches left at today's
+    factors), "<name>_patches" (tried patches) and "<name>_ms" (host wall time of the loop beyond
+    the first plan)."""
     from ...bound import scene_tolerances
 
+    last_trial = len(scales) - 1
     data = tessellator.scene_data(scene, request.sharp_edges)
     count = data.num_patches
     bezier = next((part for part in data.parts if part[0] is BEZIER), None)
@@ -105,24 +136,21 @@ def plan_integral(tessellator, scene, request, started: float):
         if "today" not in state:
             state["today"], state["flags"] = factors.get(), flags.get()
         if "trials" in state:
-            factors.set(trial_factors(state["today"], state["trials"]).reshape(factors.shape))
+            factors.set(trial_factors(state["today"], state["trials"], scales).reshape(factors.shape))
 
     scratch: dict = {}
     plan = tessellator.plan_on(data, request, started, scratch, stage1_hook=stage1_hook)
     loop_started = time.perf_counter()
-    trials = np.full(count, LAST_TRIAL, np.int64)
-    rational = np.zeros(count, bool)
-    stats = {"integral_rounds": 0, "integral_checked": 0}
+    trials = np.full(count, last_trial, np.int64)
+    tried = np.zeros(count, bool)
+    stats = {f"{name}_rounds": 0, f"{name}_checked": 0}
     if bezier is not None:
-        pyramids, pyramid_of_bezier, rational_bezier = integral_pyramids(tessellator, scene)
+        tried_bezier, device_data = prepare()
         base, n = bezier[1], bezier[2]
         flags = state["flags"][base:base + n]
-        rational[base:base + n] = rational_bezier & ~(flags & (FLAG_CULLED | FLAG_SATURATED)).astype(bool)
-        trials[rational] = 0
-    if rational.any():
-        pyramid_of = np.full(count, -1, np.int32)
-        pyramid_of[base:base + n] = pyramid_of_bezier.get()
-        pyramid_of_device = cl_array.to_device(tessellator.queue, pyramid_of)
+        tried[base:base + n] = tried_bezier & ~(flags & (FLAG_CULLED | FLAG_SATURATED)).astype(bool)
+        trials[tried] = 0
+    if tried.any():
         eps = request.tolerance.eps if isinstance(request.tolerance, ObjectSpace) else None
         pixels = request.tolerance.pixels if isinstance(request.tolerance, ScreenSpace) else None
         tolerances = cl_array.to_device(tessellator.queue, scene_tolerances(scene, eps, pixels, request.sharp_edges, for_factors=True)
@@ -132,36 +160,32 @@ def plan_integral(tessellator, scene, request, started: float):
             state["trials"] = trials
             plan = tessellator.plan_on(data, request, started, scratch, stage1_hook=stage1_hook)
             final = plan.factors.get()
-            check = rational & (trials < LAST_TRIAL) & (final != checked_at).any(axis=1)
+            check = tried & (trials < last_trial) & (final != checked_at).any(axis=1)
             if not check.any():
                 break
-            stats["integral_rounds"] += 1
+            stats[f"{name}_rounds"] += 1
             tess = tessellator.emit(plan, 0, plan.num_patches)
             triangles = np.ascontiguousarray(tess.triangles, np.uint32)
-            num = len(triangles)
-            ratios, worst = triangle_ratios(tessellator, pyramids, pyramid_of_device, check, tess.uv,
-                                            tess.patch_ids, triangles, tolerances, levels=SUBPATCH_LEVELS,
-                                            skip_failed=True, worst_of_patch=True)
-            stats["integral_checked"] += int(np.count_nonzero(ratios))
-            if not np.isfinite(worst).all():
-                raise RuntimeError(f"{scene.name}: the integral bound is not finite")
-            failing = check & (worst > 1.0)
+            ratios, worst = ratios_of(device_data, check, tess, triangles, tolerances)
+            stats[f"{name}_checked"] += int(np.count_nonzero(ratios))
+            failing = check & ~(worst <= 1.0)  # a NaN or infinite bound fails too
             passed = check & ~failing
             checked_at[passed] = final[passed]  # certified while its final factors stay these
             if not failing.any():
                 break
-            tried = trial_factors(state["today"], trials)
+            factors_tried = trial_factors(state["today"], trials, scales)
             for p in np.flatnonzero(failing):
-                # The next trial whose own factors differ, and at least JUMP_POWER of the way to
+                # The next trial whose own factors differ, and at least jump_power of the way to
                 # where a bound quadratic in the step would pass (bound ~ 1/scale^2).
-                target = TRIAL_SCALES[trials[p]] * float(worst[p]) ** JUMP_POWER
+                target = scales[trials[p]] * min(float(worst[p]), 1e30) ** jump_power
                 trials[p] += 1
-                while trials[p] < LAST_TRIAL and (
-                        TRIAL_SCALES[trials[p]] < target
-                        or (trial_factors(state["today"][p:p + 1], trials[p:p + 1]) == tried[p]).all()):
+                while trials[p] < last_trial and (
+                        scales[trials[p]] < target
+                        or (trial_factors(state["today"][p:p + 1], trials[p:p + 1], scales) == factors_tried[p]).all()):
                     trials[p] += 1
-    stats.update(integral_patches=int(rational.sum()), integral_at_hull=int(np.count_nonzero(rational & (trials == LAST_TRIAL))),
-                 integral_ms=(time.perf_counter() - loop_started) * 1e3)
+    stats.update({f"{name}_patches": int(tried.sum()),
+                  f"{name}_at_hull": int(np.count_nonzero(tried & (trials == last_trial))),
+                  f"{name}_ms": (time.perf_counter() - loop_started) * 1e3})
     plan.stats.update(stats)
-    plan.integral_trials = trials
+    plan.trials = trials
     return plan

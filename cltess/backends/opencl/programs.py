@@ -41,6 +41,7 @@ STAGE_AXES = {
     "prepared_points": ("kind", "pattern"),  # stage 4 per vertex from prepared patches (work="*-prep")
     "verify": ("kind",),  # on request only (Tessellator.verify), so not in STAGES
     "integral_bound": ("integral",),  # on request only (Request(bound="integral"): integral.py)
+    "error_hull_bound": ("error_hull",),  # on request only (Request(bound="error-hull"): error_hull.py)
     # silhouette refinement per frame (silhouette.py; they include criteria/silhouette.h)
     "silhouette_alpha": (),
     "silhouette_levels": (),
@@ -73,7 +74,8 @@ ulong flag_counts(int flag) {{ return (ulong)((flag & FLAG_CULLED) != 0) | ((ulo
 #: The stage 4-5 programs of a work distribution other than a patch per work-item
 #: (tessellator.py WORK_DISTRIBUTIONS).
 WORK_STAGES = {"rows": ("vertex_rows",), "vertex": ("vertex_points",), "point": ("vertex_points", "triangles"),
-               "vertex-prep": ("prepared_points",), "point-prep": ("prepared_points", "triangles")}
+               "vertex-prep": ("prepared_points",), "point-prep": ("prepared_points", "triangles"),
+               "rows-prep": ("prepared_points", "triangles")}
 
 
 def same_arguments(args: tuple, kept: tuple | None) -> bool:
@@ -169,7 +171,8 @@ def composition(stage: str, kind=None, pattern=None, tolerance=None, crack: str 
     ``header``), the crack policy's header, and the tolerance's and the pattern's ``defines``
     (stage 1 only: ``-D PATTERN_DYADIC`` rounds the factors for a dyadic pattern)."""
     parts = {"kind": kind and kind.header, "pattern": pattern and pattern.header, "crack": crack,
-             "level": "criteria/level.h", "integral": "criteria/integral_bound.h"}
+             "level": "criteria/level.h", "integral": "criteria/integral_bound.h",
+             "error_hull": "criteria/error_hull.h"}
     headers = tuple(parts[axis] for axis in STAGE_AXES[stage])  # stage 1 also reads the tolerance
     if None in headers:
         raise ValueError(f"stage {stage} needs {', '.join(STAGE_AXES[stage])}")

@@ -58,7 +58,19 @@ RECORDS_PER_ITEM = 4
 #: against 0.250: fewer patch searches per triangle; bench/RESULTS.md, "Issue 15: GPU stages
 #: 4-5, session 5"), and 1 slower (1.76).  "point" keeps RECORDS_PER_ITEM (the paper's scenes).
 RECORDS_PER_ITEM_PREPARED = 16
-PREPARED_WORK = ("vertex-prep", "point-prep")
+PREPARED_WORK = ("vertex-prep", "point-prep", "rows-prep")
+#: "rows-prep" (stages/prepared_points.cl prepared_rows): work-items per work-group, each walking
+#: one line (an interior row or a ring edge) of the group's patches; the kernel's LINE_GROUP
+#: (kernel line_constants, checked equal by tests/test_work_points.py).  One warp: on the H100,
+#: uniform level 16, stage 4 took 0.508-0.511 ms with groups of 32 and 32 patches against
+#: 0.539-0.542 with groups of 64 and 64 patches (the same number of warps; a warp waits for no
+#: other at the group's barriers), 0.540 at 32 and 16, 0.771 at 32 and 64 (half the warps:
+#: the SMs not filled) (bench/RESULTS.md, "Issue 15: stage 4 a work-item per row or ring edge").
+LINE_GROUP = 32
+#: Patches per work-group of "rows-prep" (a speed setting; at most the kernel's LINE_MAX_PATCHES).
+#: A scene of few patches gets few work-groups: "rows-prep" is for scenes of large patches.
+LINE_PATCHES = 32
+LINE_MAX_PATCHES = 64
 #: How stages 4-5 spread their work (docs/design.md, "Work distribution"): "patch" a work-item
 #: per patch (stages/vertices.cl, stages/indices.cl); "rows" stage 4 a work-item per (patch,
 #: row) (stages/vertex_rows.cl), stage 5 per patch; "vertex" stage 4 a work-item per output
@@ -68,7 +80,10 @@ PREPARED_WORK = ("vertex-prep", "point-prep")
 #: "vertex-prep" and "point-prep": the same, with each visible patch's kind_patch made once per
 #: frame (stages/prepared_points.cl prepare_patches, into a scratch buffer) and stage 4's
 #: work-items copying it instead of re-running kind_load at every patch change (issue 15, GPUs).
-WORK_DISTRIBUTIONS = ("patch", "rows", "vertex", "point", "vertex-prep", "point-prep")
+#: "rows-prep": stage 4 a work-item per interior row or ring edge of prepared patches, its points
+#: walked in order (one forward-differencing step each) and staged in local memory to be written
+#: side by side (stages/prepared_points.cl prepared_rows); stage 5 a work-item per triangle.
+WORK_DISTRIBUTIONS = ("patch", "rows", "vertex", "point", "vertex-prep", "point-prep", "rows-prep")
 #: The default per device type, chosen by bench/frame_loop.py --work gpu (bench/RESULTS.md, "Issue
 #: 15: the work distributions on the H100"): CPUs keep a patch per work-item (the point kernels
 #: replay forward differencing per vertex: more arithmetic, which a CPU pays); GPUs a work-item
@@ -227,12 +242,13 @@ class Tessellator:
     def __init__(self, device: cl.Device | str | None = None, rows_in_parallel: bool = False,
                  work: str | None = None):
         """work: how stages 4-5 spread over work-items (``WORK_DISTRIBUTIONS``: "patch", "rows",
-        "vertex", "point", "vertex-prep" or "point-prep", bitwise the same output); default per
+        "vertex", "point", "vertex-prep", "point-prep" or "rows-prep", bitwise the same output); default per
         device type (``default_work``).
         rows_in_parallel=True is work="rows" (stages/vertex_rows.cl)."""
         self.device = device if isinstance(device, cl.Device) else pick_device(device)
         self.one_scan = os.environ.get("CLTESS_ONE_SCAN", "1") != "0"  # stage 3: one scan, else two
         self.records_per_item = None  # stages/vertex_points.cl, triangles.cl: None is RECORDS_PER_ITEM
+        self.patches_per_group = None  # work="rows-prep": None is LINE_PATCHES
         self.work = "rows" if rows_in_parallel else work or default_work(self.device)
         if self.work not in WORK_DISTRIBUTIONS:
             raise ValueError(f"work={self.work!r}: expected one of {', '.join(WORK_DISTRIBUTIONS)}")
@@ -306,6 +322,9 @@ class Tessellator:
         if request.bound == "integral":  # tighter factors, certified triangle by triangle
             from .integral import plan_integral
             return plan_integral(self, scene, request, started)
+        if request.bound == "error-hull":  # tighter factors, certified triangle by triangle
+            from .error_hull import plan_error_hull
+            return plan_error_hull(self, scene, request, started)
         return self.plan_on(self.scene_data(scene, request.sharp_edges), request, started)
 
     def compose(self, scene: Scene, request: Request) -> None:
@@ -333,6 +352,8 @@ class Tessellator:
             self.programs.summary_scan()
         if request.bound == "integral":
             self.programs.kernel("integral_bound")
+        if request.bound == "error-hull":
+            self.programs.kernel("error_hull_bound")
 
     def scene_data(self, scene: Scene, sharp_edges: str = "straight") -> "SceneData":
         """What stays on the device for a scene whatever the tolerance or camera: every kind's
@@ -809,7 +830,8 @@ class Tessellator:
         work-items per patch of stages/vertex_rows.cl (0: one per patch, stages/vertices.cl;
         None: as ``work``).  work: "patch", "rows" (with ``MAX_ROWS_PER_PATCH``), "vertex" or
         "point" (stages/vertex_points.cl, a work-item per vertex), "vertex-prep" or "point-prep"
-        (stages/prepared_points.cl: the patches prepared first); None: the Tessellator's ``work``."""
+        (stages/prepared_points.cl: the patches prepared first), "rows-prep" (the same, a
+        work-item per row or ring edge); None: the Tessellator's ``work``."""
         out = self._vertex_arrays(vertex_range[1] - vertex_range[0]) if out is None else out
         first, last = patch_range
         if vertex_range[1] == vertex_range[0] or last <= first:
@@ -822,9 +844,9 @@ class Tessellator:
         work = work or self.work
         if rows_per_patch is None and work == "rows":
             rows_per_patch = MAX_ROWS_PER_PATCH
-        if rows_per_patch is None and work in ("vertex-prep", "point-prep"):
+        if rows_per_patch is None and work in PREPARED_WORK:
             event = self._prepared_points(controls, factors, vertex_offsets, patch_objects, vertex_range, first, last,
-                                          forward_differencing, kind, patch_base, pattern, out)
+                                          forward_differencing, kind, patch_base, pattern, out, work)
         elif rows_per_patch is None and work in ("vertex", "point"):  # work-items past the part's vertices return
             event = self.programs.kernel("vertex_points", kind=kind, pattern=pattern)(
                 self.queue, _record_groups(vertex_range[1] - vertex_range[0], self.records_for(work)), (WORK_GROUP,),
@@ -856,17 +878,28 @@ class Tessellator:
         return self._prepared
 
     def _prepared_points(self, controls, factors, vertex_offsets, patch_objects, vertex_range, first, last,
-                         forward_differencing, kind, patch_base, pattern, out) -> cl.Event:
-        """Stage 4 by vertex from prepared patches (stages/prepared_points.cl): prepare_patches
-        writes patches first .. last-1's kind_patch to a scratch buffer (kept, grown as needed;
-        the queue is in order, so a later batch's prepare waits for this batch's reads), then
-        prepared_points writes the vertices.  Returns the last event (the profiling span of
-        stage 4 runs from the first enqueued to the last)."""
+                         forward_differencing, kind, patch_base, pattern, out, work="point-prep") -> tuple:
+        """Stage 4 from prepared patches (stages/prepared_points.cl): prepare_patches writes
+        patches first .. last-1's kind_patch to a scratch buffer (kept, grown as needed; the
+        queue is in order, so a later batch's prepare waits for this batch's reads), then
+        prepared_points (a work-item per vertex) or, for work="rows-prep", prepared_rows (a
+        work-group per ``patches_per_group`` patches, a work-item per line) writes the vertices.
+        Returns both events (the profiling span of stage 4 runs from the first to the last)."""
         program = dict(kind=kind, pattern=pattern)
         self.prepared_scratch(kind, pattern, last - first)
         prepare = self.programs.kernel("prepared_points", "prepare_patches", **program)(
             self.queue, _global_size(last - first), None, controls.data, vertex_offsets.data, np.uint32(first),
             np.uint32(last - first), np.uint32(patch_base), self._prepared)
+        if work == "rows-prep":
+            per_group = self.patches_per_group or LINE_PATCHES
+            if not 0 < per_group <= LINE_MAX_PATCHES:
+                raise ValueError(f"patches_per_group={per_group}: expected 1 .. {LINE_MAX_PATCHES}")
+            rows = self.programs.kernel("prepared_points", "prepared_rows", **program)(
+                self.queue, (-(-(last - first) // per_group) * LINE_GROUP,), (LINE_GROUP,),
+                self._prepared, factors.data, vertex_offsets.data, patch_objects.data, np.uint32(first),
+                np.uint32(last - first), np.uint64(vertex_range[0]), np.int32(forward_differencing),
+                np.uint64(vertex_range[1] - vertex_range[0]), np.uint32(per_group), *(a.data for a in out.values()))
+            return prepare, rows
         per_item = self.records_for("point-prep")
         points = self.programs.kernel("prepared_points", **program)(
             self.queue, _record_groups(vertex_range[1] - vertex_range[0], per_item), (WORK_GROUP,),
@@ -891,7 +924,7 @@ class Tessellator:
         arguments = (factors.data, vertex_offsets.data, index_offsets.data, np.uint32(first),
                      np.uint32(last - first), np.uint64(index_range[0]), np.uint64(n))
         work = work or self.work
-        if work in ("point", "point-prep"):  # work-items past the part's triangles stop
+        if work in ("point", "point-prep", "rows-prep"):  # work-items past the part's triangles stop
             per_item = self.records_for(work)
             event = self.programs.kernel("triangles", pattern=_pattern(kind))(
                 self.queue, _record_groups(n // 3, per_item), (WORK_GROUP,), *arguments,
