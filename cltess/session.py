@@ -160,11 +160,12 @@ class Session:
 
     def _frame_key(self) -> tuple:
         """What a frame's launches depend on besides its camera: the tessellator's settings
-        that choose them (work distribution, records per work-item, stage 3's path) and the
-        output buffers' capacity (they are only replaced when they grow)."""
+        that choose them (work distribution, records per work-item, patches per work-group,
+        stage 3's path) and the output buffers' capacity (they are only replaced when they grow)."""
         tessellator = self.tessellator
-        return (tessellator.work, tessellator.records_per_item, tessellator.fused_offsets, tessellator.tiled_offsets,
-                tessellator.one_scan, tessellator._cpu, self.output.capacity)
+        return (tessellator.work, tessellator.records_per_item, tessellator.patches_per_group,
+                tessellator.fused_offsets, tessellator.tiled_offsets, tessellator.one_scan, tessellator._cpu,
+                self.output.capacity)
 
     def __repr__(self) -> str:
         return (f"Session({self.scene.name!r}, {self.device.name.strip()!r}, {self.frames} frames, "

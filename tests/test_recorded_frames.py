@@ -15,7 +15,7 @@ from cltess.scene import Camera
 from support import assert_same_output
 
 #: (work, stage 3 as on a GPU): the CPU's own path and a GPU's (stage 3 in one launch, or in two)
-PATHS = [("patch", False), ("point", True)]
+PATHS = [("patch", False), ("point", True), ("rows-prep", True)]
 
 
 def gpu_like(tessellator, work: str, as_gpu: bool, tiled: bool = False):
@@ -90,6 +90,12 @@ def test_a_record_is_made_again_when_its_buffers_or_settings_change(tessellator,
     assert_same_output(patch, again)
     assert_same_output(session.tessellate(camera=camera), again)
     assert len(replays) == 2
+    own.work, own.patches_per_group = "rows-prep", 8  # patches per work-group: in the key too
+    session.tessellate(camera=camera)
+    own.patches_per_group = 16
+    sixteen = session.tessellate(camera=camera)
+    assert len(replays) == 2 and session._recorded.key[2] == 16
+    assert_same_output(sixteen, again)
 
 
 def test_stage_3_in_two_launches_is_replayed_too(tessellator, tea_table, monkeypatch):
