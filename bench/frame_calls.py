@@ -20,7 +20,10 @@ warm-up pass), then three loops over the cameras, counting the calls per frame:
 The counts wrap pyopencl's entry points in this process (``pyopencl._cl.enqueue_nd_range_kernel``,
 ``_enqueue_read_buffer``, ``_enqueue_copy_buffer``, ``enqueue_map_buffer``, ``MemoryMap.release``,
 markers, ``CommandQueue.flush``, ``wait_for_events``, ``Event.wait``, event status and profiling
-queries), so they also count on a tree before this one (``PYTHONPATH=TREE``).  ``--profile N``
+queries), so they also count on a tree before this one (``PYTHONPATH=TREE``).  "Python" per
+frame: the host thread's CPU time (``time.thread_time_ns``) over a loop less its CPU time inside
+those calls, the median of ``--rounds`` loops: the frame's own host work, which a GPU's host pays
+as well, measured by CPU time so that the device's threads on the same cores do not count.  ``--profile N``
 prints, instead of the counts, cProfile's top N functions by own time over ``--profile-rounds`` overlapped loops (its own overhead
 inflates every Python figure about 2x: read it for the split, not for totals).
 """
@@ -32,6 +35,7 @@ import cProfile
 import inspect
 import json
 import pstats
+import statistics
 import sys
 import time
 from pathlib import Path
@@ -46,6 +50,10 @@ import cltess  # noqa: E402
 import frame_loop as fl  # noqa: E402
 
 COUNTS: collections.Counter = collections.Counter()
+#: The host thread's CPU ns inside the counted calls (``time.thread_time_ns``), so that a loop's
+#: CPU time less this is its Python: what a GPU's host pays the same, whatever the runtime.
+IN_CALLS = [0]
+clock = time.thread_time_ns
 
 
 def _counted(owner, name: str, label: str) -> None:
@@ -53,7 +61,11 @@ def _counted(owner, name: str, label: str) -> None:
 
     def call(*args, **kwargs):
         COUNTS[label] += 1
-        return original(*args, **kwargs)
+        started = clock()
+        try:
+            return original(*args, **kwargs)
+        finally:
+            IN_CALLS[0] += clock() - started
 
     setattr(owner, name, call)
 
@@ -63,7 +75,11 @@ def _counted_property(cls, name: str, label: str) -> None:
 
     def get(self):
         COUNTS[label] += 1
-        return prop.__get__(self)
+        started = clock()
+        try:
+            return prop.__get__(self)
+        finally:
+            IN_CALLS[0] += clock() - started
 
     setattr(cls, name, property(get))
 
@@ -95,10 +111,12 @@ def install() -> None:
     _counted(cl.Buffer, "__init__", "buffers made")
 
 
-def loop(session, path, mode: str) -> tuple[dict, float]:
-    """(calls per frame by label, wall ms per frame) of one loop over the cameras."""
+def loop(session, path, mode: str) -> tuple[dict, float, float]:
+    """(calls per frame by label, wall ms per frame, Python µs per frame) of one loop over the
+    cameras; Python: the host thread's CPU time outside the counted OpenCL calls."""
     COUNTS.clear()
-    started = time.perf_counter()
+    IN_CALLS[0] = 0
+    started, cpu = time.perf_counter(), clock()
     if mode == "overlapped":
         kept = [session.tessellate(camera=camera, wait=False) for camera in path]
         kept[-1].finish()
@@ -107,8 +125,9 @@ def loop(session, path, mode: str) -> tuple[dict, float]:
             frame = session.tessellate(camera=camera)
             if mode == "host arrays":
                 frame.fetch()
+    python = (clock() - cpu - IN_CALLS[0]) / len(path) / 1e3
     wall = (time.perf_counter() - started) / len(path) * 1e3
-    return {label: n / len(path) for label, n in sorted(COUNTS.items())}, wall
+    return {label: n / len(path) for label, n in sorted(COUNTS.items())}, wall, python
 
 
 def main() -> int:
@@ -118,6 +137,7 @@ def main() -> int:
     parser.add_argument("--scenes", nargs="*", default=["tea_table", "double_torus", "killeroo", "spheres", "model_zoo"])
     parser.add_argument("--profile", type=int, default=0, metavar="N")
     parser.add_argument("--profile-rounds", type=int, default=5, help="loops over the cameras profiled")
+    parser.add_argument("--rounds", type=int, default=3, help="loops over the cameras per mode (median of their Python)")
     parser.add_argument("--as-gpu", action="store_true",
                         help="count the calls a GPU's frame makes (work 'point', stage 3 fused up to "
                              "FUSED_OFFSETS_MAX_PATCHES) on this device; its times mean nothing")
@@ -148,9 +168,12 @@ def main() -> int:
               f"work {tessellator.work}, fused stage 3 {tessellator.fused_offsets}):")
         entry = {"scene": key}
         for mode in () if args.profile else ("on device", "host arrays") + (("overlapped",) if overlaps else ()):
-            counts, wall = loop(session, path, mode)
-            entry[mode] = {"calls": counts, "wall_ms": wall}
-            print(f"  {mode:12s} wall {wall:7.3f} ms: " + ", ".join(f"{label} {n:g}" for label, n in counts.items()))
+            loops = [loop(session, path, mode) for _ in range(args.rounds)]
+            counts, wall = loops[0][0], statistics.median(w for _, w, _ in loops)
+            python = statistics.median(p for _, _, p in loops)
+            entry[mode] = {"calls": counts, "wall_ms": wall, "python_us": python, "python_us_rounds": [p for *_, p in loops]}
+            print(f"  {mode:12s} wall {wall:7.3f} ms, Python {python:6.1f} µs: "
+                  + ", ".join(f"{label} {n:g}" for label, n in counts.items()))
         if args.profile:
             profile = cProfile.Profile()
             profile.enable()

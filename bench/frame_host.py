@@ -18,7 +18,14 @@ frame records
   in the child to time it, in both trees): the host's own work per frame;
 * "looped", "overlap" (a tree with ``Session.tessellate(wait=False)``): a loop over the cameras
   with frames that wait and with frames that overlap, the loop's wall clock over its frames
-  until the last one is finished (``frame_loop.overlapped``).
+  until the last one is finished (``frame_loop.overlapped``);
+* "host µs": the host thread's CPU time per overlapped frame less its CPU time in waits (the
+  smallest of the children's medians): the frame's own host work, Python and the runtime's
+  calls, measured by CPU time so that on a CPU device the device's threads do not count.
+
+``--as-gpu`` makes the frames a GPU makes (work "point", stage 3 in one or two launches, as
+``bench/frame_calls.py --as-gpu``) on a CPU device: its device times mean nothing, its host
+columns are the GPU path's host work on this machine's cores.
 
 Per scene the report gives, for each tree, the median over frames, then the *smallest* of the
 ``--repeat`` children's medians (the machine is shared: the least disturbed run), and the
@@ -50,19 +57,36 @@ def child(args) -> dict:
     import cltess
 
     waited = [0]  # ns blocked in pyopencl.wait_for_events (both trees wait through it)
+    waited_cpu = [0]  # the host thread's CPU ns in those waits (a runtime may spin)
     wait_for_events = cl.wait_for_events
 
     def timed_wait(events):
-        started = time.perf_counter_ns()
+        started, cpu = time.perf_counter_ns(), time.thread_time_ns()
         wait_for_events(events)
         waited[0] += time.perf_counter_ns() - started
+        waited_cpu[0] += time.thread_time_ns() - cpu
+
+    def overlapped_host_cpu(session, path, rounds: int = 3) -> float:
+        """The host thread's CPU µs per frame in a loop of overlapped frames (until the last one
+        is finished), less its CPU time in waits: the frame's host work, Python and the runtime's
+        calls, whatever else runs on the machine's cores (median of ``rounds`` loops)."""
+        loops = []
+        for _ in range(rounds):
+            waited_cpu[0] = 0
+            cpu = time.thread_time_ns()
+            frames = [session.tessellate(camera=camera, wait=False) for camera in path]
+            frames[-1].finish()
+            loops.append((time.thread_time_ns() - cpu - waited_cpu[0]) / len(path) / 1e3)
+        return statistics.median(loops)
 
     cl.wait_for_events = timed_wait
     overlaps = "wait" in inspect.signature(cltess.Session.tessellate).parameters
     from cltess.backends.opencl import Tessellator
     from cltess.bench.suite import device_info, resolve_scenes
 
-    tessellator = Tessellator(args.device)
+    tessellator = Tessellator(args.device, work="point" if args.as_gpu else None)
+    if args.as_gpu:  # a GPU's choices on this device (bench/frame_calls.py --as-gpu)
+        tessellator.fused_offsets, tessellator.tiled_offsets, tessellator._cpu = True, True, False
     rows = []
     for key in resolve_scenes(args.scenes):
         scene = fl.suite_scene(key)
@@ -89,6 +113,7 @@ def child(args) -> dict:
                "resident_host_ms": statistics.median(resident_host), "held_host_ms": statistics.median(held_host)}
         if overlaps:
             row.update(fl.overlapped(session, path))
+            row["overlapped_host_cpu_us"] = overlapped_host_cpu(session, path)
         rows.append(row)
     record = {"device": device_info(tessellator.device), "rows": rows, "cltess": cltess.__file__}
     if args.grid:
@@ -116,12 +141,15 @@ def main() -> int:
     parser.add_argument("--grid", action="store_true", help="also the one-thread NumPy grid (this tree only)")
     parser.add_argument("--baseline", metavar="SOURCE_TREE")
     parser.add_argument("--json")
+    parser.add_argument("--as-gpu", action="store_true",
+                        help="frames as a GPU makes them (work 'point', stage 3 fused or tiled) on this device")
     parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
         print(json.dumps(child(args), default=float))
         return 0
-    argv = ["--frames", str(args.frames), "--scenes", *args.scenes] + (["--device", args.device] if args.device else [])
+    argv = ["--frames", str(args.frames), "--scenes", *args.scenes] + (["--device", args.device] if args.device else []) \
+        + (["--as-gpu"] if args.as_gpu else [])
     trees = {"this": None}
     if args.baseline:
         trees["baseline"] = Path(args.baseline).resolve()
@@ -139,7 +167,7 @@ def main() -> int:
     header = f"{'scene':20} {'triangles':>10}"
     for name in trees:
         header += (f" | {name + ' device':>14} {'on device':>10} {'(host)':>7} {'ratio':>6} {'host arr.':>10} {'(host)':>7}"
-                   f" {'ratio':>6} {'looped':>8} {'overlap':>8} {'ratio':>6}")
+                   f" {'ratio':>6} {'looped':>8} {'overlap':>8} {'ratio':>6} {'host µs':>8}")
     print(header)
     result = {"device": device, "load": [load_before, os.getloadavg()], "command": " ".join(sys.argv), "scenes": []}
     for index, row in enumerate(runs["this"][0]["rows"]):
@@ -152,9 +180,10 @@ def main() -> int:
                      f" {best['host_ms']:>10.3f} {best['held_host_ms']:>7.3f} {best['host_ms'] / best['device_ms']:>5.2f}x")
             if "overlapped_wall_ms" in best:
                 line += (f" {best['looped_wall_ms']:>8.3f} {best['overlapped_wall_ms']:>8.3f}"
-                         f" {best['overlapped_wall_ms'] / best['overlapped_device_ms']:>5.2f}x")
+                         f" {best['overlapped_wall_ms'] / best['overlapped_device_ms']:>5.2f}x"
+                         f" {min(run['rows'][index]['overlapped_host_cpu_us'] for run in runs[name]):>8.1f}")
             else:
-                line += f" {'-':>8} {'-':>8} {'-':>6}"
+                line += f" {'-':>8} {'-':>8} {'-':>6} {'-':>8}"
             entry[name] = best
         print(line)
         result["scenes"].append(entry)

@@ -174,14 +174,20 @@ class Camera:
         right = _cross3(forward, np.asarray(self.up, float))
         right /= math.sqrt(right.dot(right))
         true_up = _cross3(right, forward)
-        view = np.eye(4)
-        view[0, :3], view[1, :3], view[2, :3] = right, true_up, -forward
+        view = np.zeros((4, 4))  # (np.eye's bits, without its call overhead)
+        view[0, :3], view[1, :3], view[2, :3], view[3, 3] = right, true_up, -forward, 1.0
         view[:3, 3] = -view[:3, :3] @ eye
         return view
 
     def pixel_size_at_unit_depth(self) -> float:
         """World length of one pixel at depth 1: ``2 tan(fov_y / 2) / height``."""
-        return 2.0 * np.tan(np.radians(self.fov_y_deg) / 2.0) / self.height
+        return pixel_size_at_unit_depth(self.fov_y_deg, self.height)
+
+
+def pixel_size_at_unit_depth(fov_y_deg: float, height: int) -> float:
+    """World length of one pixel at depth 1 of a camera with this field of view and image
+    height: ``2 tan(fov_y / 2) / height``."""
+    return 2.0 * np.tan(np.radians(fov_y_deg) / 2.0) / height
 
 
 def vertex_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:

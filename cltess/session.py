@@ -13,6 +13,10 @@ What a ``Session`` keeps between calls, so that a frame costs only the five stag
 * the output buffers (``OutputBuffers``), grown only when a frame needs more, and on a GPU the
   page-locked host buffers its read-back goes through.
 
+A frame for a new camera alone enqueues the launches of the last frame recorded for the
+session's request again, with stage 1's camera arguments replaced (``RecordedFrame``,
+cltess/backends/opencl/recorded.py): no kernel look-up, path choice or argument set-up.
+
 A frame does not wait for stage 3's totals before it enqueues stages 4-5: they run on the
 buffers' capacity, and write nothing if the frame's output does not fit (``batch_fits`` in
 kernels/common.h).  The host reads the totals when the frame's sizes, arrays or times are
@@ -32,6 +36,7 @@ from __future__ import annotations
 import dataclasses
 import time
 
+from .backends.opencl.recorded import RecordedFrame
 from .backends.opencl.tessellator import OutputBuffers, Tessellator
 from .criteria.tolerance import ObjectSpace, ScreenSpace
 from .request import Request
@@ -59,6 +64,7 @@ class Session:
         self.frames = 0
         self._plans: list = []  # the last two frames' plans: their totals grow the buffers for the next
         self._composed = None  # the (work, stage 3 choices) of the last frame composed for the session's request
+        self._recorded = None  # the last frame made for the session's request, to replay (RecordedFrame)
 
     @property
     def device(self):
@@ -129,17 +135,37 @@ class Session:
             if plan.settled:
                 self.output.reserve(plan.num_vertices, plan.num_indices // 3)
         # The launches keep their arguments (the session's buffers): the next frame's launches
-        # with the same ones only enqueue (programs.Kernel).
-        programs = tessellator.programs
+        # with the same ones only enqueue (programs.Kernel).  A new camera alone replays the last
+        # frame recorded for these settings and buffers (recorded.py); any other frame is made
+        # the normal way, and recorded if it was made for the session's request.
+        programs, data, scratch = tessellator.programs, self._scene_data[key], self._scratch[key]
+        recorded = self._recorded
         programs.keep_arguments = True
         try:
-            plan = tessellator.plan_on(self._scene_data[key], request, started, self._scratch[key], defer_totals=True)
-            pending = tessellator.emit_async(plan, 0, plan.num_patches, out=self.output)
+            if not request_overrides and recorded is not None and recorded.key == self._frame_key():
+                pending = recorded.replay(tessellator, data, request, started, scratch, self.output)
+            else:
+                programs.recording = [] if not request_overrides else None
+                plan = tessellator.plan_on(data, request, started, scratch, defer_totals=True)
+                pending = tessellator.emit_async(plan, 0, plan.num_patches, out=self.output)
+                if not request_overrides:
+                    self._recorded = RecordedFrame.of(self._frame_key(), data, pending, programs.recording,
+                                                      scratch.get("summary"))
         finally:
             programs.keep_arguments = False
-        self._plans = [*self._plans[-1:], plan]
+            programs.recording = None
+        self._plans = [*self._plans[-1:], pending.plan]
         self.frames += 1
         return pending.result(on_device=True, wait=wait)
+
+    def _frame_key(self) -> tuple:
+        """What a frame's launches depend on besides its camera: the tessellator's settings
+        that choose them (work distribution, records per work-item, patches per work-group,
+        stage 3's path) and the output buffers' capacity (they are only replaced when they grow)."""
+        tessellator = self.tessellator
+        return (tessellator.work, tessellator.records_per_item, tessellator.patches_per_group,
+                tessellator.fused_offsets, tessellator.tiled_offsets, tessellator.one_scan, tessellator._cpu,
+                self.output.capacity)
 
     def __repr__(self) -> str:
         return (f"Session({self.scene.name!r}, {self.device.name.strip()!r}, {self.frames} frames, "

@@ -4,12 +4,13 @@ that choose it: ``ObjectSpace(eps)`` or ``ScreenSpace(pixels, camera)``.
 """
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..scene import Camera
+from ..scene import Camera, pixel_size_at_unit_depth
 
 #: No patch gets a tolerance below this many float32 steps (ulps) at its largest coordinate
 #: (kernels/criteria/tolerance.h FLOAT32_TOLERANCE_STEPS, checked equal by
@@ -128,13 +129,29 @@ def box_tolerances(lo: np.ndarray, hi: np.ndarray, eps: float | None = None, pix
 
 
 def camera_arguments(camera: Camera | None):
-    """(view float16 row-major, frustum (tan_x, tan_y, near, far), pixel size at depth 1)."""
+    """(view float16 row-major, frustum (tan_x, tan_y, near, far) float4, pixel size at depth 1).
+    Along a camera path only the view changes: the rest is made once per lens
+    (``lens_arguments``)."""
     import pyopencl as cl  # the cl vector types; imported here so the mirror needs no platform
 
     if camera is None:
+        return lens_arguments(None)
+    view = camera.view_matrix().astype(np.float32).reshape(16).view(cl.cltypes.float16)[0]
+    return (view, *lens_arguments(camera.fov_y_deg, camera.width, camera.height, camera.near, camera.far))
+
+
+@functools.lru_cache(maxsize=64)
+def lens_arguments(fov_y_deg: float | None, width: int = 0, height: int = 0, near: float = 0.0,
+                   far: float = 0.0) -> tuple:
+    """(frustum (tan_x, tan_y, near, far) float4, pixel size at depth 1) of a camera's lens, made
+    once per lens: ``camera_arguments`` runs once per frame, and NumPy's making of a struct
+    costs a few µs each (bench/RESULTS.md, "Issue 15: a recorded frame").  None: no camera (the
+    view, frustum and pixel size all zero).  The struct is shared by every call: read only."""
+    import pyopencl as cl
+
+    if fov_y_deg is None:
         return np.zeros(16, np.float32).view(cl.cltypes.float16)[0], \
             np.zeros(4, np.float32).view(cl.cltypes.float4)[0], 0.0
-    tan_y = math.tan(math.radians(camera.fov_y_deg) / 2)
-    frustum = np.array([tan_y * camera.width / camera.height, tan_y, camera.near, camera.far], np.float32)
-    return (camera.view_matrix().astype(np.float32).reshape(16).view(cl.cltypes.float16)[0],
-            frustum.view(cl.cltypes.float4)[0], camera.pixel_size_at_unit_depth())
+    tan_y = math.tan(math.radians(fov_y_deg) / 2)
+    frustum = np.array([tan_y * width / height, tan_y, near, far], np.float32)
+    return frustum.view(cl.cltypes.float4)[0], pixel_size_at_unit_depth(fov_y_deg, height)

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import os
 import shlex
+from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 
@@ -77,6 +78,45 @@ WORK_STAGES = {"rows": ("vertex_rows",), "vertex": ("vertex_points",), "point": 
                "rows-prep": ("prepared_points", "triangles")}
 
 
+def same_arguments(args: tuple, kept: tuple | None) -> bool:
+    """Whether a launch's arguments are those kept from the last one: each the same object, or
+    an equal value of the same type; a NumPy struct (stage 1's float16 view matrix) compared by
+    its bytes, since NumPy's own comparison of two structs cost ~100 µs on this VM's CPUs
+    (bench/RESULTS.md, "Issue 15: a recorded frame")."""
+    if kept is None or len(args) != len(kept):
+        return False
+    for arg, other in zip(args, kept):
+        if arg is other:
+            continue
+        if type(arg) is not type(other):
+            return False
+        if isinstance(arg, np.void):
+            if arg.tobytes() != other.tobytes():
+                return False
+        elif arg != other:
+            return False
+    return True
+
+
+@dataclass(frozen=True)
+class Launch:
+    """One launch of a ``Kernel`` as made (``Programs.recording``): the kernel, its global and
+    local sizes, its arguments and options, and the event it returned."""
+
+    kernel: "Kernel"
+    global_size: tuple
+    local_size: tuple | None
+    args: tuple
+    options: dict
+    event: cl.Event
+
+    def again(self, queue, args: tuple | None = None) -> cl.Event:
+        """The same launch enqueued again, or with these arguments instead (each set only if
+        another launch changed it: ``Kernel``)."""
+        return self.kernel(queue, self.global_size, self.local_size, *(self.args if args is None else args),
+                           **self.options)
+
+
 class Kernel:
     """A built kernel whose scalar arguments' C types are fixed at its first launch, from the
     NumPy scalars it was given (``pyopencl.Kernel.set_arg_types``): later launches pack each
@@ -91,6 +131,8 @@ class Kernel:
     of frame after frame) enqueues the kernel alone, without setting them again (issue 15: a
     frame's host cost).  Any other launch forgets them, so that no buffer outlives its
     caller for the sake of this.
+    While ``Programs.recording`` is a list, each launch is also appended to it as a ``Launch``
+    (a Session records a frame's launches to replay them: cltess/backends/opencl/recorded.py).
     Anything else (``get_work_group_info``, ``function_name``) is the pyopencl kernel's."""
 
     __slots__ = ("kernel", "arg_types", "programs", "kept")
@@ -102,14 +144,17 @@ class Kernel:
         self.kept = None  # the last launch's arguments, still set on the kernel (Programs.keep_arguments)
 
     def __call__(self, queue, global_size, local_size, *args, **options) -> cl.Event:
-        if args == self.kept and not options:  # set by the last launch and unchanged: enqueue alone
-            return _cl.enqueue_nd_range_kernel(queue, self.kernel, global_size, local_size, None, None, False, False)
-        if self.arg_types is None:
-            self.arg_types = tuple(a.dtype if isinstance(a, np.generic) else None for a in args)
-            self.kernel.set_arg_types(self.arg_types)
-        event = self.kernel(queue, global_size, local_size, *args, **options)
-        keep = self.programs is not None and self.programs.keep_arguments and not options
-        self.kept = args if keep else None
+        if not options and same_arguments(args, self.kept):  # set by the last launch and unchanged: enqueue alone
+            event = _cl.enqueue_nd_range_kernel(queue, self.kernel, global_size, local_size, None, None, False, False)
+        else:
+            if self.arg_types is None:
+                self.arg_types = tuple(a.dtype if isinstance(a, np.generic) else None for a in args)
+                self.kernel.set_arg_types(self.arg_types)
+            event = self.kernel(queue, global_size, local_size, *args, **options)
+            keep = self.programs is not None and self.programs.keep_arguments and not options
+            self.kept = args if keep else None
+        if self.programs is not None and self.programs.recording is not None:
+            self.programs.recording.append(Launch(self, global_size, local_size, args, options, event))
         return event
 
     def __getattr__(self, name):
@@ -178,6 +223,8 @@ class Programs:
         #: Whether launches keep their arguments for the next (``Kernel``): on while a Session
         #: enqueues a frame, whose buffers live with the session.
         self.keep_arguments = False
+        #: A list to which every launch is appended (``Launch``) while a Session records a frame.
+        self.recording = None
         self.offsets_scan = GenericScanKernel(
             context, np.uint64, arguments="__global const ulong *counts, __global ulong *offsets",
             input_expr="counts[i]", scan_expr="a+b", neutral="0",

@@ -210,6 +210,12 @@ def _record_groups(records: int, per_item: int) -> tuple[int]:
     return (max(1, -(-records // per_group)) * WORK_GROUP,)
 
 
+#: Where stage 1's tolerance arguments (``kernel_args()`` of ObjectSpace, ScreenSpace) sit among
+#: its kernel's (stage_factors_of, stages/factors.cl): the only arguments of a Session frame's
+#: launches that change with the camera (recorded.py).
+TOLERANCE_ARGUMENTS = slice(4, 9)
+
+
 def wait_ms(events) -> float:
     """Wait for events; the host milliseconds spent blocked (a frame's wall_ms["waits"])."""
     started = time.perf_counter()
@@ -667,10 +673,10 @@ class Tessellator:
         pattern: the kind's own unless given; a dyadic one rounds the factors to 2^p_e,
         p_e <= max_level."""
         count = len(data["source"])
+        arguments = (data["source"].data, data["controls"].data, np.uint32(count), np.uint32(patch_base),
+                     *tolerance.kernel_args(), np.int32(max_factor), np.int32(max_level), factors.data, flags.data)
         event = self.programs.kernel("factors", kind=kind, tolerance=tolerance, pattern=pattern or kind.pattern)(
-            self.queue, _global_size(count), None, data["source"].data, data["controls"].data, np.uint32(count),
-            np.uint32(patch_base), *tolerance.kernel_args(), np.int32(max_factor), np.int32(max_level),
-            factors.data, flags.data)
+            self.queue, _global_size(count), None, *arguments)
         return [event]
 
     def stage_crack_free(self, factors, groups, crack="crack/max.h", out=None):
@@ -952,9 +958,11 @@ class OutputArrays(dict):
     """The pyopencl arrays of one output (name -> ``pyopencl.array.Array``, made on first
     access: a frame whose output nobody looks at on the device does not pay for them)."""
 
-    def __init__(self, queue, layout, buffers: dict, num_vertices: int, num_triangles: int):
+    def __init__(self, queue, fields: dict, buffers: dict, num_vertices: int, num_triangles: int):
+        """fields: name -> (dtype, per-row shape) (``OutputBuffers.FIELDS``); buffers: name ->
+        device buffer."""
         super().__init__()
-        self.queue, self.layout, self.buffers = queue, {name: (dtype, shape) for name, dtype, shape in layout}, buffers
+        self.queue, self.layout, self.buffers = queue, fields, buffers
         self.num_vertices, self.num_triangles = num_vertices, num_triangles
 
     def raw(self, name: str) -> _Raw:
@@ -1107,10 +1115,14 @@ class OutputBuffers:
         self.read_back_wait_ms = 0.0  # host ms blocked in the last read_back
         self._parent = None  # a mapped device's one allocation (_take_mapped), its fields' offsets
         self._offsets: dict = {}
+        self._capacity = (0, 0)  # (vertices, triangles) of the buffers (_grow)
+        self._field_buffers: dict = {}  # name -> device buffer (_grow)
 
     #: (name, dtype, per-row shape) of every output buffer: the vertex record, then triangles.
     LAYOUT = tuple((name, np.dtype(dtype), shape) for name, dtype, shape in VERTEX_RECORD) + \
         (("triangles", np.dtype(np.uint32), (3,)),)
+    #: name -> (dtype, per-row shape), as OutputArrays reads them.
+    FIELDS = {name: (dtype, shape) for name, dtype, shape in LAYOUT}
 
     @classmethod
     def _layout(cls):
@@ -1118,27 +1130,36 @@ class OutputBuffers:
 
     def take(self, num_vertices: int, num_triangles: int) -> dict:
         """pyopencl arrays of (num_vertices, ...) per vertex field and (num_triangles, 3)
-        triangles, on buffers at least that large; a new generation."""
+        triangles, on buffers at least that large; a new generation.  Within the buffers'
+        capacity (frame after frame of a Session) nothing but the generation changes."""
         self.generation += 1
         self.unmap()
+        vertices, triangles = self._capacity
+        if num_vertices > vertices or num_triangles > triangles or not self._buffers:
+            self._grow(num_vertices, num_triangles)
+        return OutputArrays(self.queue, self.FIELDS, self._field_buffers, num_vertices, num_triangles)
+
+    def _grow(self, num_vertices: int, num_triangles: int) -> None:
+        """Buffers for at least this many vertices and triangles (the first allocation as asked;
+        growing, a quarter more)."""
         layout = self._layout()
         if self.mapped:
             self._take_mapped(layout, num_vertices, num_triangles)
-            return OutputArrays(self.queue, layout, {name: self._buffers[name][0] for name, _, _ in layout},
-                                num_vertices, num_triangles)
-        flags = cl.mem_flags.READ_WRITE
-        for name, dtype, shape in layout:
-            rows = num_triangles if name == "triangles" else num_vertices
-            row_bytes = dtype.itemsize * math.prod(shape)
-            buffer, capacity = self._buffers.get(name, (None, -1))
-            if rows > capacity:  # the first allocation as asked; growing, a quarter more
-                capacity = rows if buffer is None else int(rows * self.GROWTH)
-                self._buffers.pop(name, None)
-                self._staging.pop(name, None)
-                buffer = cl.Buffer(self.context, flags, max(capacity, 1) * row_bytes)
-                self._buffers[name] = (buffer, capacity)
-        return OutputArrays(self.queue, layout, {name: self._buffers[name][0] for name, _, _ in layout},
-                            num_vertices, num_triangles)
+        else:
+            flags = cl.mem_flags.READ_WRITE
+            for name, dtype, shape in layout:
+                rows = num_triangles if name == "triangles" else num_vertices
+                row_bytes = dtype.itemsize * math.prod(shape)
+                buffer, capacity = self._buffers.get(name, (None, -1))
+                if rows > capacity:
+                    capacity = rows if buffer is None else int(rows * self.GROWTH)
+                    self._buffers.pop(name, None)
+                    self._staging.pop(name, None)
+                    buffer = cl.Buffer(self.context, flags, max(capacity, 1) * row_bytes)
+                    self._buffers[name] = (buffer, capacity)
+        self._field_buffers = {name: self._buffers[name][0] for name, _, _ in layout}
+        self._capacity = (min(capacity for name, (_, capacity) in self._buffers.items() if name != "triangles"),
+                          self._buffers["triangles"][1])
 
     def _take_mapped(self, layout, num_vertices: int, num_triangles: int) -> None:
         """A CPU device's buffers: every field a sub-buffer of one ``ALLOC_HOST_PTR`` allocation
@@ -1219,10 +1240,7 @@ class OutputBuffers:
     @property
     def capacity(self) -> tuple[int, int]:
         """(vertices, triangles) the buffers hold now; (0, 0) before the first ``take``."""
-        if not self._buffers:
-            return 0, 0
-        return (min(capacity for name, (_, capacity) in self._buffers.items() if name != "triangles"),
-                self._buffers["triangles"][1])
+        return self._capacity
 
     def reserve(self, num_vertices: int, num_triangles: int) -> None:
         """Grow the buffers now (as ``take`` would) if they hold fewer than this."""
