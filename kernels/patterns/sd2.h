@@ -32,6 +32,7 @@
 #undef CLTESS_PATTERNS_LAYOUT_H  /* layout.h again below, for this pattern's own names */
 #undef PATTERN_EDGE_POINTS
 #undef PATTERN_UNIFORM_ROWS
+#undef PATTERN_CHORD_POINTS
 
 #define SD2_CULLED 0
 #define SD2_FAN 1        /* two equal factors: the SD-2 pattern */
@@ -43,6 +44,7 @@ inline int sd2_segments(int4 f, int e) { return odd_segments(factor_of(f, e)); }
 
 #define PATTERN_EDGE_POINTS(f, e) sd2_segments(f, e)
 #define PATTERN_UNIFORM_ROWS 0  /* rows at fractional points: stage 4 evaluates them directly */
+#define PATTERN_CHORD_POINTS 1  /* the tie zone's centres: pattern_chord_point, below */
 
 inline int4 sd2_whole(int4 f) { return (int4)(sd2_segments(f, 0), sd2_segments(f, 1), sd2_segments(f, 2), 0); }
 
@@ -272,7 +274,6 @@ inline uint sd2_centre(int4 n, int c, int i, int j)
  * stage 4 gives vertex v.  On the surface a centre stood off its row's chord by up to the row's
  * chord error, a fin that moved the mesh by most of the error at low factors whenever lam moved
  * (docs/sd2.md section 5). */
-#define PATTERN_CHORD_POINTS 1
 inline int pattern_chord_point(int4 f, int j, int i, __private uint *start, __private uint *end,
                                __private float *mu)
 {
