@@ -302,7 +302,8 @@ def measure(tessellator, scene, sweep: float, steps: int, low: float, high: floa
         out[count] = {"step_deg": sweep / count, "worst": float(step_worst.max()), "median": median,
                       "jumps": int(np.count_nonzero(step_worst > 4 * median)), "tips": int(tips), "steps": count,
                       "relaid": int(relaid), "triangles": int(np.mean([f.num_triangles for f in frames])),
-                      "triple": int(triple), "worst_other": float(others.max()), "no_blend": no_blend}
+                      "triple": int(triple), "worst_other": float(others.max()), "no_blend": no_blend,
+                      "step_worst": [float(x) for x in step_worst]}
     return out
 
 

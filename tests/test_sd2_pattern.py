@@ -229,13 +229,18 @@ def test_silhouette_ramp_is_continuous_and_the_classes_are_its_limit():
 
 def lifted(record) -> tuple[np.ndarray, np.ndarray]:
     """(points (V, 3), triangles (T, 3, 3)): a record's pattern lifted onto a curved surface,
-    (u, v, h(u, v)), every vertex on it as the pipeline evaluates them.  The domain layout can
+    (u, v, h(u, v)), every vertex on it as the pipeline evaluates them (the zone's centres on their
+    rows' chords, sd2_chords).  The domain layout can
     stay close while the mesh in space does not: a vertex sliding along a long row of the domain
     stands off that row's chord by up to its chord error."""
+    from cltess.patterns.base import place_chords
+    from cltess.patterns.sd2 import sd2_chords
+
     uv, triangles = sd2_pattern(record)
     u, v = uv[:, 0], uv[:, 1]
     w = 1 - u - v
     points = np.column_stack([u, v, u * u + 2 * v * v + 3 * w * w + u * v])
+    points = place_chords(points, sd2_chords(record))  # the zone's centres on their rows' chords
     return points, points[triangles]
 
 
@@ -283,29 +288,30 @@ def plateau_error(n: int) -> float:
     return PLATEAU_ERROR[n]
 
 
-@settings(max_examples=30, deadline=None)
-@given(st.integers(0, 2), st.floats(0.0, 1.0))
-def test_leaving_the_plateau_of_1_moves_the_mesh_in_proportion(corner, rate):
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2), st.floats(0.0, 1.0), st.sampled_from([1, 2]))
+def test_leaving_the_plateau_of_1_moves_the_mesh_in_proportion(corner, rate, neighbour):
     """A corner leaving the plateau of 1 (the silhouette beyond its band; depth clamped), its
-    neighbour c+1 rising at a fraction of its rate or not (lam = 1: the fan starts from the
-    plateau's grid): the lifted mesh moves at most 1.6 errors per factor unit (uniform refinement
-    from 1: 0.96), and the first 1/64 of a unit by under 5% of the error.  Before: the zone's
-    quad centres kept w (1 - w) / 4 of their row off their corner, and at low factors the rows
-    span the triangle (rows at x and 1 - x, x -> 0), so they slid through it at 2.2 errors per
-    unit (docs/sd2.md section 5; bench/sd2_pops.py).  With the slower neighbour c+2 instead
-    (lam = e2 / e1 strictly between 0 and 1) the departure still jumps: section 5, "Triple ties"."""
+    neighbour c+1 or c+2 rising at a fraction of its rate or not: the lifted mesh moves at most 1.6
+    errors per factor unit (uniform refinement from 1: 0.96), and the first 1/64 of a unit by under
+    5% of the error.  With c+1 (lam = 1) the fan starts from the plateau's grid; with c+2 rising
+    lam = 1 - rate from the first unit on, the centres stand inside rows that span the triangle,
+    and before they went on the chord (sd2_chords) the first 1/64 moved the mesh by 0.59-0.83 of the
+    error (a fin as high as the base's chord error).  Before that, the floor w (1 - w) / 4 on the
+    centres' slide moved them at 2.2 errors per unit (docs/sd2.md section 5; bench/sd2_pops.py)."""
     step = 1 / 64
 
     def record(d):
         phi = [1.0, 1.0, 1.0]
         phi[corner] += d
-        phi[(corner + 1) % 3] += rate * d
+        phi[(corner + neighbour) % 3] += rate * d
         return hinted_record([round(x * FIXED_ONE) for x in phi])
 
     error = plateau_error(1)
-    assert lifted_distance(hinted_record([FIXED_ONE] * 3), record(step)) < 0.05 * error
+    first = lifted_distance(hinted_record([FIXED_ONE] * 3), record(step))
+    assert first < 0.05 * error, (corner, rate, neighbour, first / error)
     fastest = max(lifted_distance(record(d), record(d + step)) for d in np.arange(0.0, 0.95, 0.05)) / step
-    assert fastest < 1.6 * error, (corner, rate, fastest / error)
+    assert fastest < 1.6 * error, (corner, rate, neighbour, fastest / error)
 
 
 @settings(max_examples=40, deadline=None)

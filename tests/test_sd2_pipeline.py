@@ -194,19 +194,31 @@ def test_factors_move_with_the_step(tessellator):
     # corner at a time; before lam = min(e2 / e1, 1) they popped (ratio 0.998, 2 steps standing
     # out; steep factors: the distance saturates at the meshes' error beyond about 1 degree)
     dict(level_function="depth", low=3.0, high=7.0, sweep=4.0, depth_range=(2.5, 3.5)),
+    # the plateaus of 1 and 5, left with the tip's c+2 rising too (lam = 1 - q): 0.00253 / 0.00130
+    # at 1 / 0.5 degree; before the zone's centres went on their rows' chords 0.01862 / 0.01197,
+    # which these criteria pass too (ratio 0.64): test_sd2_pattern.py's plateau-of-1 test tells
+    # them apart
+    dict(level_function="depth", low=1.0, high=5.0, sweep=4.0, depth_range=(2.5, 3.5)),
 ])
 def test_no_pops_along_an_orbit(tessellator, case):
     """Consecutive frames along an orbit differ by an amount proportional to the step, tips
     moving and plateaus left included: halving the step takes the worst Hausdorff distance
     between frames (bench/sd2_pops.py, from every patch's vertices, both ways) well below the
-    coarse step's, and no step stands out (> 4 x the median)."""
+    coarse step's, no step stands out (> 4 x the median) at the coarse step, and a step that stands
+    out at the half step is below 0.8 of the coarse step it is half of (a pop is as large at
+    every step size).  (That last clause since the zone's centres went on their rows' chords:
+    the median fell by 2.8 and depth's triple-tie patch, 0.00809 at the coarse step, stood out
+    at the half step as 0.00456 and 0.00415, 4.2 x the median, in proportion.)"""
     case = dict(case)
     pops = load_pops_bench()
     result = pops.measure(tessellator, icosphere(1), steps=4, how="vertices", **case)
     coarse, fine = result[4], result[8]
     assert fine["tips"] > 0  # tips do move along these paths
     assert fine["worst"] < 0.8 * coarse["worst"], result
-    assert fine["jumps"] == 0 and coarse["jumps"] == 0, result
+    halves = np.array(fine["step_worst"])
+    out = np.flatnonzero(halves > 4 * fine["median"])
+    assert (halves[out] < 0.8 * np.array(coarse["step_worst"])[out // 2]).all(), result
+    assert coarse["jumps"] == 0, result
 
 
 def load_pops_bench():

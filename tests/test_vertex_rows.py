@@ -8,13 +8,17 @@ import pytest
 
 from cltess.backends.opencl import tessellator as opencl
 from cltess.io import load_scene
+from cltess.scene import Camera
 from cltess.tessellation import HOST_FIELDS
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
 CASES = [("teapot.bez", dict(eps=1e-3)), ("teapot.bez", dict(eps=1e-3, forward_differencing=False)),
          ("tea_table.json", dict(pixels=0.5)), ("sphere.bpt", dict(eps=1e-3, pattern="semi_uniform")),
          ("cylinder.stl", dict(eps=1e-3)), ("cylinder.stl", dict(eps=1e-3, pattern="semi_uniform")),
-         ("torus.bpt", dict(eps=1e-4, max_factor=100))]
+         ("torus.bpt", dict(eps=1e-4, max_factor=100)),
+         # SD-2 from a level function: fans in the tie zone, whose centres stage 4 puts on chords
+         ("cylinder.stl", dict(eps=1e-3, pattern="sd2", level_function="depth", level_factors=(1.0, 7.0),
+                               camera=Camera(eye=np.array([3.0, 1.0, 2.0]), target=np.zeros(3))))]
 
 
 @pytest.fixture(scope="module")

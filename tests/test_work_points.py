@@ -15,6 +15,7 @@ from cltess import reference
 from cltess.backends.opencl import tessellator as opencl
 from cltess.io import load_scene
 from cltess.kinds import BEZIER
+from cltess.scene import Camera
 from cltess.tessellation import HOST_FIELDS
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
@@ -24,7 +25,10 @@ CASES = [("teapot.bez", dict(eps=1e-3)), ("teapot.bez", dict(eps=1e-3, forward_d
          ("sphere.bpt", dict(eps=1e-3, pattern="semi_uniform")),
          ("cylinder.stl", dict(eps=1e-3)), ("cylinder.stl", dict(eps=1e-3, pattern="semi_uniform")),
          ("torus.bpt", dict(eps=1e-4, max_factor=100)), ("teacup.bez", dict(eps=1e-3, pattern="esc")),
-         ("teapot.bez", dict(eps=1e-3, pattern="sd2"))]
+         ("teapot.bez", dict(eps=1e-3, pattern="sd2")),
+         # SD-2 from a level function: fans in the tie zone, whose centres stage 4 puts on chords
+         ("cylinder.stl", dict(eps=1e-3, pattern="sd2", level_function="depth", level_factors=(1.0, 7.0),
+                               camera=Camera(eye=np.array([3.0, 1.0, 2.0]), target=np.zeros(3))))]
 
 
 @pytest.fixture(scope="module")

@@ -14,6 +14,7 @@ from ..crack.or_masks import policy as crack_policy
 from ..kinds import FACTOR_SLOTS, FLAG_CULLED, FLAG_SATURATED, KINDS
 from ..kinds import kind as kind_named
 from ..patterns import quad_pattern, tri_pattern
+from ..patterns.base import place_chords
 from ..patterns.semi_uniform import dyadic_factors, level_histogram
 from ..request import Request
 from ..scene import Scene
@@ -42,13 +43,13 @@ def offsets(counts_: np.ndarray) -> np.ndarray:
 
 
 def tessellate(patches: np.ndarray, factors: np.ndarray, object_ids: np.ndarray | None = None,
-               pattern=None, evaluator=None, patch_base: int = 0) -> dict:
+               pattern=None, evaluator=None, patch_base: int = 0, chords=None) -> dict:
     """Vertices and triangles of all patches at the given final factors (direct evaluation).
 
     Returns a dict of positions (V, 3), normals (V, 3), uv (V, 2), patch_ids (V,),
     object_ids (V,), triangles (T, 3): the layout the kernels write.  pattern, evaluator:
     quad_pattern and evaluate by default (pn_tessellate passes the PN ones); patch ids are
-    ``patch_base + p``.
+    ``patch_base + p``.  chords: the pattern's vertices on chords (Pattern.chords), or None.
     """
     pattern, evaluator = pattern or quad_pattern, evaluator or evaluate
     object_ids = np.zeros(len(patches), np.int32) if object_ids is None else object_ids
@@ -59,6 +60,8 @@ def tessellate(patches: np.ndarray, factors: np.ndarray, object_ids: np.ndarray 
         if not len(uv):
             continue
         pos, nrm = evaluator(patches[p], uv[:, 0], uv[:, 1])
+        if chords is not None:  # stage 4's chord points (kernels/stages/rows.h chord_position)
+            pos = place_chords(pos, chords(f))
         out["positions"].append(pos)
         out["normals"].append(nrm)
         out["uv"].append(uv)
@@ -201,7 +204,7 @@ class NumpyBackend:
             if lo >= hi:
                 continue
             out = tessellate(controls[lo - base:hi - base], plan.factors[lo:hi], plan.objects[lo:hi],
-                             pattern.layout, kind.surface.evaluate, lo)
+                             pattern.layout, kind.surface.evaluate, lo, pattern.chords)
             out["triangles"] = out["triangles"] + plan.vertex_offsets[lo]
             pieces.append(out)
         arrays = {name: np.concatenate([p[name] for p in pieces]).astype(dtype).reshape((-1, *shape))

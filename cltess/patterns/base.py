@@ -34,6 +34,11 @@ class Pattern:
                ESC: esc.strip_indices); the NumPy backend's Tessellation.strips.
     layout:    the NumPy mirror, f -> (uv (V, 2) float64, triangles (T, 3) int64 local indices):
                the ring first, then the interior rows, as the device lays the vertices out.
+    chords:    f -> the vertices that stage 4 places on a chord of the mesh rather than on the
+               surface, ``(vertices (K,), start (K,), end (K,), mu (K,))`` (local numbers):
+               vertex k at ``P[start] + mu (P[end] - P[start])``, P the other vertices'
+               positions (kernels/patterns/layout.h PATTERN_CHORD_POINTS; place_chords; SD-2's
+               tie-zone centres, sd2.sd2_chords); None: none.
     counts_walk: its counts walk the whole pattern rather than a closed form or a table (ESC
                before its tables, esc.ESC_WALK: every band of the 18 coarse triangles): stage 3
                then keeps a work-item per patch over the whole device, never the
@@ -53,6 +58,7 @@ class Pattern:
     fixed_point: bool = False
     stage1: tuple = ()
     strips: Callable | None = None
+    chords: Callable | None = None
     counts_walk: bool = False
 
     @property
@@ -68,3 +74,16 @@ class Pattern:
 
     def __repr__(self) -> str:
         return f"<Pattern {self.name}>"
+
+
+def place_chords(positions: np.ndarray, chords) -> np.ndarray:
+    """positions (V, 3) of one patch with its chord vertices (Pattern.chords: vertices, start, end,
+    mu) moved onto their chords, ``P[start] + mu (P[end] - P[start])``, exactly P[start] at
+    mu = 0.  The NumPy mirror of stage 4's chord points (kernels/stages/rows.h chord_position)."""
+    vertices, start, end, mu = chords
+    out = np.array(positions, copy=True)
+    if len(vertices):
+        p0, p1 = out[start], out[end]
+        moved = p0 + mu[:, None].astype(out.dtype) * (p1 - p0)
+        out[vertices] = np.where(mu[:, None] > 0, moved, p0)
+    return out

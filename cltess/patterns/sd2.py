@@ -65,8 +65,7 @@ def _point(c: int, t: np.float32, s: np.float32) -> np.ndarray:
 #: ``(phi_m << HINT_SHIFT) | m``, m the corner of the smallest per-vertex factor phi_m (16.16,
 #: the edge factors being the larger of their ends' phi); 0: no hint.  kernels/patterns/sd2.h.
 HINT_SHIFT = 2
-#: The zone quad centre's floor factor (kernels/patterns/sd2.h SD2_CENTRE_FLOOR; _centre_mu).
-CENTRE_FLOOR = 1.0 / 64
+
 
 
 def sd2_hint(f) -> tuple[int, int] | None:
@@ -116,18 +115,13 @@ def _fan_z(t: np.float32, s: np.float32, w: np.float32, lam: np.float32) -> np.f
 
 def _centre_mu(w: np.float32, lam: np.float32) -> np.float32:
     """How far a zone quad's centre has slid from its corner (i, j+1) towards (i, j):
-    ``(1 - w) max(1 - lam, CENTRE_FLOOR w)``.  (1 - w)(1 - lam) is the slide of docs/sd2.md
-    section 5; the floor w (1 - w) / 64, zero at the zone's two ends (w = 1: the radial pattern,
-    w = 0: a tie), keeps the centre off (i, j+1) inside the zone when lam = 1: the last column's
-    (i, j+1) is a ring point, whose position the ring evaluates, and a centre on it, evaluated as
-    an interior point, would differ in the last bits (a T-junction of an ulp).  Small: the centre
-    is evaluated on the surface, and at low factors its row spans the triangle, so each unit of
-    slide moves the mesh by up to that row's chord error (the first floor, w (1 - w) / 4, moved a
-    corner's departure from the plateau of 1 at 2.3 errors per factor unit; / 64: 1.0, uniform
-    refinement 0.96).  At w = 1/65536 it is still 2.4e-7 of the row, 4 float32 ulps of 1.
-    Device: sd2.h."""
+    ``(1 - w)(1 - lam)`` (docs/sd2.md section 5): 0 at the zone's outer edge (w = 1, the radial
+    pattern's diagonal) and wherever the tie partner is c+1 (lam = 1), 1 at a tie with c+2 (the
+    other diagonal).  The centre is a vertex of its row on both sides (the quad below fans from
+    it, the triangle above is split at it), placed in space on the chord between its row
+    neighbours (sd2_chords), so it may sit on (i, j+1) itself.  Device: sd2.h sd2_centre_mu."""
     one = np.float32(1.0)
-    return np.float32(np.float32(one - w) * max(np.float32(one - lam), np.float32(np.float32(CENTRE_FLOOR) * w)))
+    return np.float32(np.float32(one - w) * np.float32(one - lam))
 
 
 def _row_point(c: int, t: np.float32, z: np.float32) -> np.ndarray:
@@ -206,6 +200,59 @@ class _Layout:
         return self.ring_size + (i - 2) * (i - 1) // 2 + (j - 1)
 
 
+def _zone(lay: "_Layout") -> tuple[list, np.float32]:
+    """(z, mu) of a fan in the tie zone: z[i][j] corner c+2's weight of vertex (i, j) (_fan_z),
+    mu the centres' slide (_centre_mu)."""
+    c = lay.tip
+    a, b = lay.n[c], lay.n[(c + 1) % 3]
+    t, s = locations(lay.f[c]), locations(lay.f[(c + 1) % 3])
+    z = [[_fan_z(t[i], s[j], lay.w, lay.lam) for j in range(b + 1)] for i in range(a + 1)]
+    return z, _centre_mu(lay.w, lay.lam)
+
+
+def _zone_strips(lay: "_Layout") -> list[np.ndarray]:
+    """The tie zone's strips (docs/sd2.md section 5).  Centre C(i, j) of the quad between rows i,
+    i+1 and radial lines j, j+1 lies on row i between A = (i, j) and E = (i, j+1), and is a
+    vertex of both sides of that row: the tip's triangle (i = 1) or the quad above has its lower
+    edge A E split at it, and the quad fans from it to B = (i+1, j), D = (i+1, j+1) and the
+    lower row's own centre C' = C(i+1, j) on B D (none on the base).  Per radial pair:
+    ``[A1, C1, tip, E1]``, then per quad ``[A, B, C, C', D]`` and ``[C, D, E]``, or
+    ``[A, B, C, D, E]`` on the base's row."""
+    c = lay.tip
+    a, b = lay.n[c], lay.n[(c + 1) % 3]
+    strips = []
+    for j in range(b):
+        strips.append([lay.sd2(1, j), lay.centre(1, j), lay.sd2(0, 0), lay.sd2(1, j + 1)])
+        for i in range(1, a):
+            A, B, D, E = lay.sd2(i, j), lay.sd2(i + 1, j), lay.sd2(i + 1, j + 1), lay.sd2(i, j + 1)
+            C = lay.centre(i, j)
+            if i + 1 < a:
+                strips += [[A, B, C, lay.centre(i + 1, j), D], [C, D, E]]
+            else:
+                strips.append([A, B, C, D, E])
+    return [np.array(strip, np.int64) for strip in strips]
+
+
+def sd2_chords(f) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The vertices that stage 4 places on a chord of the mesh rather than on the surface
+    (kernels/patterns/sd2.h pattern_chord_point; kernels/stages/rows.h chord_position): the tie
+    zone's centres.  (vertices (K,), start (K,), end (K,) local numbers, mu (K,) float32): vertex k
+    goes to ``P[start] + mu (P[end] - P[start])``, P the other vertices' positions, start its row's
+    vertex (i, j+1) and end (i, j).  A centre on the surface stood off its row's chord by up to the
+    row's chord error, a fin that moved the mesh by most of the error at low factors whenever lam
+    moved (docs/sd2.md section 5); on the chord it only moves its quad's fan between the quad's two
+    diagonals.  Empty outside the zone."""
+    lay = _Layout(f)
+    if lay.shape != "sd2" or not lay.zone:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0, np.float32)
+    a, b = lay.n[lay.tip], lay.n[(lay.tip + 1) % 3]
+    pairs = [(i, j) for i in range(1, a) for j in range(b)]
+    return (np.array([lay.centre(i, j) for i, j in pairs], np.int64),
+            np.array([lay.sd2(i, j + 1) for i, j in pairs], np.int64),
+            np.array([lay.sd2(i, j) for i, j in pairs], np.int64),
+            np.full(len(pairs), _centre_mu(lay.w, lay.lam), np.float32))
+
+
 def sd2_layout(f) -> tuple[np.ndarray, list[np.ndarray]]:
     """(uv (V, 2) float32, strips: list of (L,) int64 local index arrays) of fixed factors f."""
     lay = _Layout(f)
@@ -226,21 +273,14 @@ def sd2_layout(f) -> tuple[np.ndarray, list[np.ndarray]]:
                 strips.append(np.array(strip, np.int64))
         else:
             # the tie zone: vertices pulled towards the tie configuration, and each quad's centre
-            # sliding on its upper row from corner (i, j+1) (the radial pattern's diagonal) to
+            # on its upper row, slid from corner (i, j+1) (the radial pattern's diagonal) towards
             # (i, j) (the other diagonal, partner c+2) by mu = (1 - w)(1 - lam)
-            w, lam = lay.w, lay.lam
-            z = [[_fan_z(t[i], s[j], w, lam) for j in range(b + 1)] for i in range(a + 1)]
-            uv += [_row_point(c, t[i], z[i][j])[:2] for i in range(1, a) for j in range(1, b)]
-            mu = _centre_mu(w, lam)
+            z, mu = _zone(lay)
             keep = np.float32(1.0) - mu
+            uv += [_row_point(c, t[i], z[i][j])[:2] for i in range(1, a) for j in range(1, b)]
             uv += [_row_point(c, t[i], np.float32(np.float32(keep * z[i][j + 1]) + np.float32(mu * z[i][j])))[:2]
                    for i in range(1, a) for j in range(b)]
-            for j in range(b):
-                strips.append(np.array([lay.sd2(0, 0), lay.sd2(1, j), lay.sd2(1, j + 1)], np.int64))
-                for i in range(1, a):
-                    A, B, D, E = lay.sd2(i, j), lay.sd2(i + 1, j), lay.sd2(i + 1, j + 1), lay.sd2(i, j + 1)
-                    C = lay.centre(i, j)
-                    strips += [np.array([A, B, C, D, E], np.int64), np.array([E, A, C], np.int64)]
+            strips += _zone_strips(lay)
     elif lay.shape == "grid":
         n = lay.n[0]
         t = locations(lay.f[0])
@@ -289,7 +329,7 @@ def sd2_counts(f) -> tuple[int, int, int]:
     if lay.shape == "sd2":
         a, b = lay.n[lay.tip], lay.n[(lay.tip + 1) % 3]
         if lay.zone:
-            return a * (b + 1) + 1 + (a - 1) * b, b * (4 * a - 3), b * (10 * a - 6)
+            return a * (b + 1) + 1 + (a - 1) * b, b * (4 * a - 3), b * (10 * a - 9)
         return a * (b + 1) + 1, b * (2 * a - 1), b * (2 * a + 2)
     if lay.shape == "grid":
         n = lay.n[0]
@@ -298,4 +338,5 @@ def sd2_counts(f) -> tuple[int, int, int]:
     return len(uv), len(triangles), 4 * len(triangles)
 
 
-SD2 = Pattern("sd2", "tri", 3, "patterns/sd2.h", sd2_pattern, primitive="strips", fixed_point=True)
+SD2 = Pattern("sd2", "tri", 3, "patterns/sd2.h", sd2_pattern, primitive="strips", fixed_point=True,
+              chords=sd2_chords)

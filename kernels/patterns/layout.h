@@ -16,6 +16,13 @@
 #ifndef PATTERN_UNIFORM_ROWS
 #define PATTERN_UNIFORM_ROWS 1
 #endif
+/* 1: some row points go on a chord of the mesh rather than on the surface: the pattern defines
+ * pattern_chord_point(f, j, i, &start, &end, &mu) (patterns/sd2.h), and stage 4 puts row point
+ * (j, i), when it returns 1, at P_start + mu (P_end - P_start), P_v the position it gives layout
+ * vertex v (itself never a chord point; stages/rows.h chord_position). */
+#ifndef PATTERN_CHORD_POINTS
+#define PATTERN_CHORD_POINTS 0
+#endif
 
 inline uint pattern_vertex_count(int4 f)
 {

@@ -32,6 +32,7 @@
 #undef CLTESS_PATTERNS_LAYOUT_H  /* layout.h again below, for this pattern's own names */
 #undef PATTERN_EDGE_POINTS
 #undef PATTERN_UNIFORM_ROWS
+#undef PATTERN_CHORD_POINTS
 
 #define SD2_CULLED 0
 #define SD2_FAN 1        /* two equal factors: the SD-2 pattern */
@@ -43,6 +44,7 @@ inline int sd2_segments(int4 f, int e) { return odd_segments(factor_of(f, e)); }
 
 #define PATTERN_EDGE_POINTS(f, e) sd2_segments(f, e)
 #define PATTERN_UNIFORM_ROWS 0  /* rows at fractional points: stage 4 evaluates them directly */
+#define PATTERN_CHORD_POINTS 1  /* the tie zone's centres: pattern_chord_point, below */
 
 inline int4 sd2_whole(int4 f) { return (int4)(sd2_segments(f, 0), sd2_segments(f, 1), sd2_segments(f, 2), 0); }
 
@@ -72,13 +74,6 @@ inline int sd2_hint(int4 f, int *m, int *phi)
     *phi = h >> SD2_HINT_SHIFT;
     return h > 0 && *m < 3;
 }
-
-/* The zone quad centre's floor factor (mirror CENTRE_FLOOR, _centre_mu; docs/sd2.md section 5):
- * the centre keeps (1 - w) w SD2_CENTRE_FLOOR of its row off corner (i, j+1), a ring point in the
- * last column.  Small, because the centre is evaluated on the surface: sliding it along a long
- * row (low factors) moves the mesh by up to the row's chord error (1/4 moved a corner leaving the
- * plateau of 1 at 2.3 errors per factor unit, 1/64 at 1.0). */
-#define SD2_CENTRE_FLOOR 0.015625f  /* 1 / 64 */
 
 /* The tie zone of the fan with tip c (mirror sd2_morph): 1 when in it, with *w the radial
  * pattern's weight (F - G) / 1.0 and *lam the weight of the tie with partner c+1,
@@ -113,6 +108,10 @@ inline float sd2_fan_z(float t, float s, float w, float lam)
     float y = (1.0f - w) * tie;
     return x + y;
 }
+
+/* How far a zone quad's centre has slid on its row from (i, j+1) towards (i, j) (mirror
+ * _centre_mu): (1 - w)(1 - lam); 0 at the zone's outer edge and where the partner is c+1. */
+inline float sd2_centre_mu(float w, float lam) { return (1.0f - w) * (1.0f - lam); }
 
 /* Barycentric point on the row at location t from corner c with corner c+2 weight z. */
 inline float3 sd2_row_point(int c, float t, float z)
@@ -193,11 +192,11 @@ inline float3 pattern_row_point(int4 f, int j, int i)
             float t = sd2_location(big, j);
             return sd2_row_point(tip, t, sd2_fan_z(t, sd2_location(base, i), w, lam));
         }
-        /* the centre of quad (r, i - 1), sliding on row r from (r, i) to (r, i - 1) by mu, kept
-         * off (r, i) inside the zone (mirror _centre_mu) */
+        /* the centre of quad (r, i - 1), slid on row r from (r, i) to (r, i - 1) by mu (mirror
+         * sd2_layout): its domain point; in space it goes on its row's chord (pattern_chord_point) */
         int r = j - (a - 1);
         float t = sd2_location(big, r);
-        float mu = (1.0f - w) * fmax(1.0f - lam, SD2_CENTRE_FLOOR * w);
+        float mu = sd2_centre_mu(w, lam);
         float keep = 1.0f - mu;
         float right = keep * sd2_fan_z(t, sd2_location(base, i), w, lam);
         float left = mu * sd2_fan_z(t, sd2_location(base, i - 1), w, lam);
@@ -268,6 +267,30 @@ inline uint sd2_centre(int4 n, int c, int i, int j)
     return (uint)(n.s0 + n.s1 + n.s2 + (a - 1) * (b - 1) + (i - 1) * b + j);
 }
 
+/* Row points that stage 4 places on a chord of the mesh rather than on the surface
+ * (stages/rows.h chord_position; mirror sd2_chords): the tie zone's centres.  Returns 1 for row
+ * point (j, i) when it is one, with *start and *end the local numbers of its row neighbours
+ * (r, i) and (r, i - 1) and *mu: it goes to P_start + mu (P_end - P_start), P_v the position
+ * stage 4 gives vertex v.  On the surface a centre stood off its row's chord by up to the row's
+ * chord error, a fin that moved the mesh by most of the error at low factors whenever lam moved
+ * (docs/sd2.md section 5). */
+inline int pattern_chord_point(int4 f, int j, int i, __private uint *start, __private uint *end,
+                               __private float *mu)
+{
+    int tip, shape = sd2_shape(f, &tip);
+    float w, lam;
+    if (shape != SD2_FAN || !sd2_morph(f, tip, &w, &lam))
+        return 0;
+    int4 n = sd2_whole(f);
+    int a = factor_of(n, tip);
+    if (j < a)
+        return 0;
+    *start = sd2_vertex(n, tip, j - (a - 1), i);
+    *end = sd2_vertex(n, tip, j - (a - 1), i - 1);
+    *mu = sd2_centre_mu(w, lam);
+    return 1;
+}
+
 /* Local number of grid vertex (i, j): row i (i + 1 points) parallel to the edge opposite
  * corner g, point j from edge g. */
 inline uint grid_vertex(int4 n, int g, int i, int j)
@@ -289,12 +312,15 @@ inline void sd2_walk(int4 f, int collapsed, __private strip_writer *w)
     int4 n = sd2_whole(f);
     float weight, lam;
     if (shape == SD2_FAN && sd2_morph(f, tip, &weight, &lam)) {
-        /* the tie zone: per radial pair the tip's triangle, then each quad A B D E with its
-         * centre C as two strips [A, B, C, D, E] and [E, A, C] */
+        /* the tie zone (mirror _zone_strips): centre C of quad (i, j) is a vertex of row i on both
+         * sides, the triangle above split at it, the quad fanning from it to B, C' (the lower
+         * row's centre, none on the base) and D: per radial pair [A1, C1, tip, E1], then per
+         * quad [A, B, C, C', D] and [C, D, E], or [A, B, C, D, E] on the base's row */
         int a = factor_of(n, tip), b = factor_of(n, (tip + 1) % 3);
         for (int j = 0; j < b; ++j) {
-            strip_put(w, sd2_vertex(n, tip, 0, 0));
             strip_put(w, sd2_vertex(n, tip, 1, j));
+            strip_put(w, sd2_centre(n, tip, 1, j));
+            strip_put(w, sd2_vertex(n, tip, 0, 0));
             strip_put(w, sd2_vertex(n, tip, 1, j + 1));
             strip_end(w);
             for (int i = 1; i < a; ++i) {
@@ -304,12 +330,17 @@ inline void sd2_walk(int4 f, int collapsed, __private strip_writer *w)
                 strip_put(w, A);
                 strip_put(w, B);
                 strip_put(w, C);
-                strip_put(w, D);
-                strip_put(w, E);
-                strip_end(w);
-                strip_put(w, E);
-                strip_put(w, A);
-                strip_put(w, C);
+                if (i + 1 < a) {
+                    strip_put(w, sd2_centre(n, tip, i + 1, j));
+                    strip_put(w, D);
+                    strip_end(w);
+                    strip_put(w, C);
+                    strip_put(w, D);
+                    strip_put(w, E);
+                } else {
+                    strip_put(w, D);
+                    strip_put(w, E);
+                }
                 strip_end(w);
             }
         }
@@ -363,7 +394,7 @@ inline int sd2_closed_counts(int4 f, uint *triangles, uint *strip_indices)
         float w, lam;
         int zone = sd2_morph(f, tip, &w, &lam);
         *triangles = zone ? b * (4 * a - 3) : b * (2 * a - 1);
-        *strip_indices = zone ? b * (10 * a - 6) : b * (2 * a + 2);
+        *strip_indices = zone ? b * (10 * a - 9) : b * (2 * a + 2);
         return 1;
     }
     if (shape == SD2_GRID) {

@@ -187,7 +187,7 @@ void prepared_rows(__global const kind_patch *restrict prepared, __global const 
             } else {
                 for (int s = 0; s < staging; ++s) {
                     patch = prepared[p - first_patch];
-                    row_point(&patch, f, row, k + s, forward_differencing, &walk, &x, &position, &normal);
+                    row_point(&patch, f, collapsed, row, k + s, forward_differencing, &walk, &x, &position, &normal);
                     stage_point(staged, own + (uint)s, position, normal, x);
                 }
             }

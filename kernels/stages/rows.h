@@ -34,11 +34,82 @@ ALWAYS_INLINE ulong put_ring(__private const kind_patch *patch, int4 f, int coll
     return at;
 }
 
+/* Vertex v (0 .. pattern_vertex_count(f) - 1) of a patch alone, as put_ring / put_rows compute it
+ * before chord_position: *x its domain point, *position, *normal; *j its row (0: the ring) and *i
+ * its point.  A ring point as put_ring computes it; a row point directly, or by forward
+ * differencing replayed from its row's start (kind_row_begin, then kind_row_next i times: the
+ * same operations in the same order as put_rows, so the same bits; the earlier steps' positions
+ * and normals are dead and left out by the compiler). */
+ALWAYS_INLINE void layout_point(__private const kind_patch *patch, int4 f, int collapsed, uint v,
+                                int forward_differencing, __private float3 *x, __private float3 *position,
+                                __private float3 *normal, __private int *j, __private int *i)
+{
+#if !PATTERN_UNIFORM_ROWS
+    forward_differencing = 0;
+#endif
+    int on_ring = 0;
+    __attribute__((opencl_unroll_hint))  /* e constant in each copy, as in put_ring */
+    for (int e = 0; e < PATTERN_EDGES; ++e) {
+        uint ring_count = (uint)PATTERN_EDGE_POINTS(f, e);
+        if (!on_ring && v < ring_count) {
+            *position = ring_position(patch, f, collapsed, e, (int)v, x);
+            on_ring = 1;
+        } else if (!on_ring) {
+            v -= ring_count;
+        }
+    }
+    if (on_ring) {
+        kind_eval(patch, *x, 0, normal);
+        *j = 0;
+        *i = 0;
+        return;
+    }
+    int rows = pattern_rows(f), row = 1, steps = pattern_row(f, 1);  /* row holds points 1 .. steps - 1 */
+    while (row < rows && v >= (uint)(steps - 1)) {
+        v -= (uint)(steps - 1);
+        steps = pattern_row(f, ++row);
+    }
+    int point = (int)v + 1;
+    *x = pattern_row_point(f, row, point);
+    *j = row;
+    *i = point;
+    if (forward_differencing) {
+        kind_row r;
+        float3 unused_position, unused_normal;
+        kind_row_begin(patch, pattern_row_point(f, row, 0), pattern_row_point(f, row, steps), steps, &r);
+        for (int s = 1; s < point; ++s)
+            kind_row_next(patch, &r, pattern_row_point(f, row, s), &unused_position, &unused_normal);
+        kind_row_next(patch, &r, *x, position, normal);
+    } else {
+        kind_eval(patch, *x, position, normal);
+    }
+}
+
+/* Row point (j, i) on a chord (patterns/layout.h PATTERN_CHORD_POINTS; mirror
+ * cltess/patterns/base.py place_chords): *position moved to P_start + mu (P_end - P_start), the
+ * layout vertices' own positions (layout_point: the ring's by kind_boundary_point), exactly
+ * P_start at mu = 0; the normal stays the surface's at the point's domain point. */
+ALWAYS_INLINE void chord_position(__private const kind_patch *patch, int4 f, int collapsed, int j, int i,
+                                  int forward_differencing, __private float3 *position)
+{
+#if PATTERN_CHORD_POINTS
+    uint start, end;
+    float mu;
+    if (pattern_chord_point(f, j, i, &start, &end, &mu)) {
+        float3 x, p0, p1, normal;
+        int row, point;
+        layout_point(patch, f, collapsed, start, forward_differencing, &x, &p0, &normal, &row, &point);
+        layout_point(patch, f, collapsed, end, forward_differencing, &x, &p1, &normal, &row, &point);
+        *position = mu > 0.0f ? p0 + mu * (p1 - p0) : p0;
+    }
+#endif
+}
+
 /* Interior rows first_row .. last_row of patch p from output slot at: each row's points
  * i = 1 .. steps - 1 by forward differencing (kind_row_begin/next) or direct evaluation
  * (kind_eval); a pattern whose rows are not equally spaced (PATTERN_UNIFORM_ROWS 0) always
  * directly. */
-ALWAYS_INLINE void put_rows(__private const kind_patch *patch, int4 f, int first_row, int last_row,
+ALWAYS_INLINE void put_rows(__private const kind_patch *patch, int4 f, int collapsed, int first_row, int last_row,
                             int forward_differencing, vertex_out out, ulong at, uint p, int object)
 {
 #if !PATTERN_UNIFORM_ROWS
@@ -53,12 +124,14 @@ ALWAYS_INLINE void put_rows(__private const kind_patch *patch, int4 f, int first
             for (int i = 1; i < steps; ++i) {
                 float3 x = pattern_row_point(f, j, i);
                 kind_row_next(patch, &row, x, &position, &normal);
+                chord_position(patch, f, collapsed, j, i, forward_differencing, &position);
                 put_vertex(out, at++, position, normal, x.xy, p, object);
             }
         } else {
             for (int i = 1; i < steps; ++i) {
                 float3 x = pattern_row_point(f, j, i);
                 kind_eval(patch, x, &position, &normal);
+                chord_position(patch, f, collapsed, j, i, forward_differencing, &position);
                 put_vertex(out, at++, position, normal, x.xy, p, object);
             }
         }
@@ -66,50 +139,15 @@ ALWAYS_INLINE void put_rows(__private const kind_patch *patch, int4 f, int first
 }
 
 /* Vertex v (0 .. pattern_vertex_count(f) - 1) of patch p alone, to output slot at, bitwise what
- * put_ring / put_rows write there: a ring point as put_ring computes it; a row point directly,
- * or by forward differencing replayed from its row's start (kind_row_begin, then kind_row_next
- * i times: the same operations in the same order as put_rows, so the same bits; the earlier
- * steps' positions and normals are dead and left out by the compiler). */
+ * put_ring / put_rows write there (layout_point, then chord_position). */
 ALWAYS_INLINE void put_point(__private const kind_patch *patch, int4 f, int collapsed, uint v,
                              int forward_differencing, vertex_out out, ulong at, uint p, int object)
 {
-#if !PATTERN_UNIFORM_ROWS
-    forward_differencing = 0;
-#endif
     float3 x, position, normal;
-    int on_ring = 0;
-    __attribute__((opencl_unroll_hint))  /* e constant in each copy, as in put_ring */
-    for (int e = 0; e < PATTERN_EDGES; ++e) {
-        uint ring_count = (uint)PATTERN_EDGE_POINTS(f, e);
-        if (!on_ring && v < ring_count) {
-            position = ring_position(patch, f, collapsed, e, (int)v, &x);
-            on_ring = 1;
-        } else if (!on_ring) {
-            v -= ring_count;
-        }
-    }
-    if (on_ring) {
-        kind_eval(patch, x, 0, &normal);
-        put_vertex(out, at, position, normal, x.xy, p, object);
-        return;
-    }
-    int rows = pattern_rows(f), j = 1, steps = pattern_row(f, 1);  /* row j holds points 1 .. steps - 1 */
-    while (j < rows && v >= (uint)(steps - 1)) {
-        v -= (uint)(steps - 1);
-        steps = pattern_row(f, ++j);
-    }
-    int i = (int)v + 1;
-    x = pattern_row_point(f, j, i);
-    if (forward_differencing) {
-        kind_row row;
-        float3 unused_position, unused_normal;
-        kind_row_begin(patch, pattern_row_point(f, j, 0), pattern_row_point(f, j, steps), steps, &row);
-        for (int s = 1; s < i; ++s)
-            kind_row_next(patch, &row, pattern_row_point(f, j, s), &unused_position, &unused_normal);
-        kind_row_next(patch, &row, x, &position, &normal);
-    } else {
-        kind_eval(patch, x, &position, &normal);
-    }
+    int j, i;
+    layout_point(patch, f, collapsed, v, forward_differencing, &x, &position, &normal, &j, &i);
+    if (j > 0)
+        chord_position(patch, f, collapsed, j, i, forward_differencing, &position);
     put_vertex(out, at, position, normal, x.xy, p, object);
 }
 
@@ -148,16 +186,17 @@ ALWAYS_INLINE void edge_point(__private const kind_patch *patch, int4 f, int col
 
 /* Point k + 1 of interior row `row`, bitwise what put_rows writes there: directly, or as the next
  * step of `walk` (kind_row_begin'd by the caller, stepped once per point in order, as put_rows
- * does). */
-ALWAYS_INLINE void row_point(__private const kind_patch *patch, int4 f, int row, int k, int forward_differencing,
-                             __private kind_row *walk, __private float3 *x, __private float3 *position,
-                             __private float3 *normal)
+ * does), then moved onto its chord where the pattern puts it there (chord_position). */
+ALWAYS_INLINE void row_point(__private const kind_patch *patch, int4 f, int collapsed, int row, int k,
+                             int forward_differencing, __private kind_row *walk, __private float3 *x,
+                             __private float3 *position, __private float3 *normal)
 {
     *x = pattern_row_point(f, row, k + 1);
     if (forward_differencing)
         kind_row_next(patch, walk, *x, position, normal);
     else
         kind_eval(patch, *x, position, normal);
+    chord_position(patch, f, collapsed, row, k + 1, forward_differencing, position);
 }
 
 /* Stage 4 by vertex (stages/vertex_points.cl, prepared_points.cl): a work-group of G work-items

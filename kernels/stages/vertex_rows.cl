@@ -41,5 +41,5 @@ __kernel void vertex_rows(__global const float4 *controls, __global const int4 *
         for (int j = 1; j < first_row; ++j)
             at += (ulong)(pattern_row(f, j) - 1);
     }
-    put_rows(&patch, f, first_row, last_row, forward_differencing, out, at, p, object);
+    put_rows(&patch, f, collapsed, first_row, last_row, forward_differencing, out, at, p, object);
 }

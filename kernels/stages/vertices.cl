@@ -26,5 +26,5 @@ __kernel void vertices(__global const float4 *controls, __global const int4 *fac
     kind_load(controls, p - patch_base, &patch);
     ulong at = vertex_offsets[p] - vertex_base;
     at = put_ring(&patch, f, collapsed, out, at, p, object);  /* stages/rows.h */
-    put_rows(&patch, f, 1, pattern_rows(f), forward_differencing, out, at, p, object);
+    put_rows(&patch, f, collapsed, 1, pattern_rows(f), forward_differencing, out, at, p, object);
 }

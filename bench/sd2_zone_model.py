@@ -1,0 +1,78 @@
+"""The SD-2 tie zone on a model surface (issue 13; docs/sd2.md section 5, "Sixth pass"): records
+lifted onto (u, v, h(u, v)) as tests/test_sd2_pattern.py lifts them (the zone's centres on their
+rows' chords where the tree's mirror has sd2_chords), distances in units of the lifted error at
+factor 1 (the grid of 1 against the grid of 41).  NumPy only.
+
+    python bench/sd2_zone_model.py                  # both parts; about 10 min on the shared VM
+    PYTHONPATH=/tmp/base python bench/sd2_zone_model.py   # another tree's mirror and helpers
+
+departures: leaving the plateau of n (all phi = n) with the tip rising by d and its c+2 at q of
+  that rate (lam = 1 - q): the move in the first 1/64 of a factor unit, and the fastest move per
+  factor unit over d in [0, 1) (uniform refinement from 1: 0.96 errors per unit).
+triple: a loop of radius r factor units around a triple tie at factor n (phi_k = n + r cos(theta
+  + 2 pi k / 3), 72 angles): its diameter (the largest distance between two of its meshes, each
+  against every sixth other).  A pop at the triple point: the diameter does not shrink with r.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+
+TREE = Path(os.environ.get("PYTHONPATH", "").split(os.pathsep)[0] or Path(__file__).resolve().parents[1])
+sys.path.insert(0, str(TREE / "tests"))
+sys.path.insert(0, str(TREE))
+
+import test_sd2_pattern as model  # noqa: E402
+from cltess.patterns.fractional import FIXED_ONE  # noqa: E402
+
+
+def record(phi) -> list:
+    return model.hinted_record([round(x * FIXED_ONE) for x in phi])
+
+
+def departures(plateaus=(1, 3, 7), rates=(0.25, 0.5, 0.75), step=1 / 64):
+    for n in plateaus:
+        error = model.plateau_error(n)
+        for q in rates:
+            at = lambda d: record([n + d, n, n + q * d])  # tip corner 0, its c+2 = corner 2
+            first = model.lifted_distance(record([n] * 3), at(step)) / error
+            fastest = max(model.lifted_distance(at(d), at(d + step)) for d in np.arange(0.0, 0.95, 0.05)) / step / error
+            print(f"plateau {n}, c+2 at {q} of the tip's rate: first 1/64 unit {first:.3f} of its error, "
+                  f"fastest {fastest:.2f} errors per unit", flush=True)
+
+
+def triple(factors=(1.05, 1.2, 1.5, 2.0, 3.05), radii=(0.02, 0.005)):
+    error = model.plateau_error(1)
+    for n in factors:
+        diameters = []
+        for r in radii:
+            meshes = [model.lifted(record([n + r * np.cos(theta + 2 * np.pi * k / 3) for k in range(3)]))
+                      for theta in np.linspace(0, 2 * np.pi, 72, endpoint=False)]
+            worst = 0.0
+            for a in range(len(meshes)):
+                for b in range(a + 1, len(meshes), 6):
+                    (pa, ta), (pb, tb) = meshes[a], meshes[b]
+                    worst = max(worst, model.point_triangle_distances(pa, tb).max(),
+                                model.point_triangle_distances(pb, ta).max())
+            diameters.append(worst / error)
+        print(f"triple tie at {n}: loop diameter " + ", ".join(f"r = {r}: {d:.3f}" for r, d in zip(radii, diameters))
+              + " of the factor-1 error", flush=True)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("part", nargs="?", choices=("departures", "triple", "both"), default="both")
+    args = parser.parse_args()
+    print(f"tree {TREE}")
+    if args.part in ("departures", "both"):
+        departures()
+    if args.part in ("triple", "both"):
+        triple()
+
+
+if __name__ == "__main__":
+    main()
