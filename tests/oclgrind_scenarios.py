@@ -347,7 +347,7 @@ def error_hull_bound():
     kernel (boxes halved and dropped, the per-patch early stop) on every emitted triangle,
     transition triangles included, then the final emission."""
     scene, options = integral_bound()
-    return scene, dict(options, eps=0.2, bound="error-hull")
+    return scene, dict(options, eps=0.4, bound="error-hull")
 
 
 SCENARIOS = {

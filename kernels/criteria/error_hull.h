@@ -63,6 +63,17 @@ inline float3 error_hull_point(__global const float4 *net, float2 x, float radiu
     return h.xyz / h.w;
 }
 
+/* Whether the box [lo, hi] lies strictly on the far side of the line a b from c (all four
+ * corners; false for a degenerate triangle, whose inside is 0). */
+inline int error_hull_beyond_edge(float2 lo, float2 hi, float2 a, float2 b, float2 c)
+{
+    float2 n = (float2)(a.y - b.y, b.x - a.x);
+    float inside = dot(n, c - a);
+    float4 side = (float4)(dot(n, (float2)(lo.x, lo.y) - a), dot(n, (float2)(hi.x, lo.y) - a),
+                           dot(n, (float2)(lo.x, hi.y) - a), dot(n, (float2)(hi.x, hi.y) - a));
+    return (inside > 0.0f && all(side < 0.0f)) || (inside < 0.0f && all(side > 0.0f));
+}
+
 /* Whether the box [lo, hi] can meet the triangle: false only when the box widened by
  * MEET_WIDENING lies strictly outside one of its edges (separating axes; the bounding box's
  * axes hold for every box cut from it). */
@@ -70,17 +81,8 @@ inline int error_hull_meets(float2 lo, float2 hi, float2 x0, float2 x1, float2 x
 {
     lo -= ERROR_HULL_MEET_WIDENING;
     hi += ERROR_HULL_MEET_WIDENING;
-    float2 xs[3] = {x0, x1, x2};
-    for (int k = 0; k < 3; ++k) {
-        float2 a = xs[k], b = xs[(k + 1) % 3], c = xs[(k + 2) % 3];
-        float2 n = (float2)(a.y - b.y, b.x - a.x);
-        float inside = dot(n, c - a);
-        float4 side = (float4)(dot(n, (float2)(lo.x, lo.y) - a), dot(n, (float2)(hi.x, lo.y) - a),
-                               dot(n, (float2)(lo.x, hi.y) - a), dot(n, (float2)(hi.x, hi.y) - a));
-        if ((inside > 0.0f && all(side < 0.0f)) || (inside < 0.0f && all(side > 0.0f)))
-            return 0;
-    }
-    return 1;
+    return !(error_hull_beyond_edge(lo, hi, x0, x1, x2) || error_hull_beyond_edge(lo, hi, x1, x2, x0)
+             || error_hull_beyond_edge(lo, hi, x2, x0, x1));
 }
 
 /* l at the point y (barycentric solve by Cramer's rule on float32 differences) and in *slack a
@@ -178,15 +180,21 @@ inline float error_hull_ratio(__global const float4 *net, float radius, float2 x
     float3 p2 = error_hull_point(net, x2, radius, &s2);
     float3 d1 = p1 - p0, d2 = p2 - p0;
     float point_slack = fmax(fmax(s0, s1), s2);  /* |l_computed P - l_P| <= it on the triangle */
-    float4 stack[ERROR_HULL_STACK];
+    /* the boxes to do (lo.x, lo.y, hi.x, hi.y; halvings): scalar arrays, as Oclgrind's
+     * uninitialised-value plugin (unoptimised build) crashed on a private float4 array here */
+    float stack_u0[ERROR_HULL_STACK], stack_v0[ERROR_HULL_STACK], stack_u1[ERROR_HULL_STACK], stack_v1[ERROR_HULL_STACK];
     int depth[ERROR_HULL_STACK];
-    stack[0] = (float4)(fmin(fmin(x0, x1), x2), fmax(fmax(x0, x1), x2));
+    float2 first_lo = fmin(fmin(x0, x1), x2), first_hi = fmax(fmax(x0, x1), x2);
+    stack_u0[0] = first_lo.x;
+    stack_v0[0] = first_lo.y;
+    stack_u1[0] = first_hi.x;
+    stack_v1[0] = first_hi.y;
     depth[0] = 0;
     int top = 1;
     float worst = 0.0f;
     while (top > 0) {
         --top;
-        float4 box = stack[top];
+        float4 box = (float4)(stack_u0[top], stack_v0[top], stack_u1[top], stack_v1[top]);
         int level = depth[top];
         float ratio = (error_hull_box(net, radius, box.xy, box.zw, x0, x1, x2, p0, d1, d2) + point_slack) / tolerance;
         if (ratio <= 1.0f) {
@@ -196,14 +204,18 @@ inline float error_hull_ratio(__global const float4 *net, float radius, float2 x
         if (level == ERROR_HULL_DEPTH)
             return ratio;
         float2 mid = (box.xy + box.zw) * 0.5f;
-        float4 quarters[4] = {(float4)(box.x, box.y, mid.x, mid.y), (float4)(mid.x, box.y, box.z, mid.y),
-                              (float4)(box.x, mid.y, mid.x, box.w), (float4)(mid.x, mid.y, box.z, box.w)};
-        for (int q = 0; q < 4; ++q)
-            if (error_hull_meets(quarters[q].xy, quarters[q].zw, x0, x1, x2)) {
-                stack[top] = quarters[q];
+        for (int q = 0; q < 4; ++q) {  /* (lo, lo), (hi, lo), (lo, hi), (hi, hi) halves in (u, v) */
+            float4 quarter = (float4)((q & 1) ? mid.x : box.x, (q & 2) ? mid.y : box.y,
+                                      (q & 1) ? box.z : mid.x, (q & 2) ? box.w : mid.y);
+            if (error_hull_meets(quarter.xy, quarter.zw, x0, x1, x2)) {
+                stack_u0[top] = quarter.x;
+                stack_v0[top] = quarter.y;
+                stack_u1[top] = quarter.z;
+                stack_v1[top] = quarter.w;
                 depth[top] = level + 1;
                 ++top;
             }
+        }
     }
     return worst;
 }
