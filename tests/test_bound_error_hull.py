@@ -169,12 +169,14 @@ def test_every_emitted_triangle_is_certified_on_a_rational_grid(tessellator, rng
     assert (uses == 2).all()
 
 
+@pytest.mark.parametrize("bound", ["error-hull", "integral"])  # the two bounds of the trial loop
 @pytest.mark.parametrize("name", ["sphere.bpt", "torus.bpt"])
 @pytest.mark.parametrize("relative_eps", [3e-2, 1e-3])
-def test_closed_rational_scenes_stay_watertight(tessellator, name, relative_eps):
+def test_closed_rational_scenes_stay_watertight(tessellator, name, relative_eps, bound):
     scene = load_scene(SCENES / name)
     eps = relative_eps * scene.diagonal
-    plan, hull = _plans(tessellator, scene, eps)
+    plan = tessellator.plan(scene, eps=eps, bound=bound, max_factor=4096)
+    hull = tessellator.plan(scene, eps=eps, max_factor=4096)
     assert (np.abs(plan.factors.get()) <= np.abs(hull.factors.get())).all()
     tess = tessellator.emit(plan, 0, plan.num_patches)
     assert np.isfinite(tess.positions).all() and np.isfinite(tess.normals).all()

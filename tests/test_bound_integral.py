@@ -252,23 +252,6 @@ def test_every_emitted_triangle_is_certified_on_a_rational_grid(tessellator, rng
     assert (uses == 2).all()  # closed, manifold
 
 
-@pytest.mark.parametrize("name", ["sphere.bpt", "torus.bpt"])
-@pytest.mark.parametrize("relative_eps", [3e-2, 1e-3])
-def test_closed_rational_scenes_stay_watertight(tessellator, name, relative_eps):
-    scene = load_scene(SCENES / name)
-    eps = relative_eps * scene.diagonal
-    plan, hull = _integral_and_hull(tessellator, scene, eps)
-    assert (np.abs(plan.factors.get()) <= np.abs(hull.factors.get())).all()
-    tess = tessellator.emit(plan, 0, plan.num_patches)
-    assert np.isfinite(tess.positions).all() and np.isfinite(tess.normals).all()
-    mesh = weld_exact(tess.positions, tess.triangles)
-    _, uses = np.unique(np.sort(mesh.edges, axis=1), axis=0, return_counts=True)
-    assert (uses == 2).all()
-    error = dense_errors(np.asarray(scene.patches, float), tess.positions, tess.uv, tess.patch_ids, tess.triangles,
-                         order=6)
-    assert error.max() <= eps
-
-
 def test_polynomial_patches_keep_the_hull_factors(tessellator):
     scene = load_scene(SCENES / "teapot.bez")
     plan, hull = _integral_and_hull(tessellator, scene, 1e-2)
