@@ -49,7 +49,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import frame_loop  # noqa: E402  (teapots, uniform_request, FILL_SOURCE)
 
 from cltess.backends.opencl import Tessellator  # noqa: E402
-from cltess.backends.opencl.programs import composition, correctly_rounded_division, kernel_dir  # noqa: E402
+from cltess.backends.opencl import programs as programs_module  # noqa: E402
+from cltess.backends.opencl.programs import Programs, composition, correctly_rounded_division, kernel_dir  # noqa: E402
 from cltess.bench.suite import device_info, machine_info  # noqa: E402
 from cltess.kinds import BEZIER  # noqa: E402
 from cltess.tessellation import VERTEX_RECORD  # noqa: E402
@@ -63,14 +64,17 @@ def cpu_seconds() -> float:
 
 
 def timed(launch, repeat: int) -> dict:
-    """Device ms and process CPU ms of ``launch()`` (returns an event), each repeat waited."""
+    """Device ms and process CPU ms of ``launch()`` (returns an event, or the list of events of
+    a stage launched as several kernels: its device time runs from the first one's start to the
+    last one's end), each repeat waited."""
     device, cpu = [], []
     for _ in range(repeat):
         started = cpu_seconds()
-        event = launch()
-        event.wait()
+        events = launch()
+        events = events if isinstance(events, list) else [events]
+        events[-1].wait()
         cpu.append((cpu_seconds() - started) * 1e3)
-        device.append((event.profile.end - event.profile.start) * 1e-6)
+        device.append((events[-1].profile.end - events[0].profile.start) * 1e-6)
     return {"device_ms": min(device), "device_ms_median": statistics.median(device),
             "cpu_ms": min(cpu), "cpu_ms_median": statistics.median(cpu)}
 
@@ -96,6 +100,11 @@ def main(argv=None) -> int:
     parser.add_argument("--copies", type=int, default=1000, help="teapots (32 patches each)")
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--baseline-kernels", help="a kernels/ folder to build stages 4-5 from too")
+    parser.add_argument("--work", nargs="*", default=[],
+                        help="work distributions (tessellator.py WORK_DISTRIBUTIONS) whose stages 4 and 5 to measure "
+                             "through the engine's stage functions, from each tree")
+    parser.add_argument("--rounds", type=int, default=2, help="rounds of every launch, interleaved (at least 2)")
+    parser.add_argument("--no-probes", action="store_true", help="leave out the stage 4 probes")
     parser.add_argument("--json")
     args = parser.parse_args(argv)
 
@@ -133,11 +142,37 @@ def main(argv=None) -> int:
         kernels[label] = (
             build(context, device, folder, (folder / "stages" / "vertices.cl").read_text(), "vertices", part.pattern).vertices,
             build(context, device, folder, (folder / "stages" / "indices.cl").read_text(), "indices", part.pattern).indices)
+    engines = {"": tessellator}
+    if args.baseline_kernels and args.work:  # a Tessellator whose programs are built from the baseline's kernels/
+        engines["baseline "] = Tessellator(args.device, work="patch")
+        engines["baseline "].programs = Programs(context)
+    vertex_out = dict(zip((name for name, _, _ in VERTEX_RECORD), out))
+
+    def work_stage4(engine, work):
+        return lambda: engine.stage_vertices(part.data["controls"], plan.factors, plan.vertex_offsets, plan.objects,
+                                             (0, vertices), (0, patches), kind=part.kind, out=vertex_out,
+                                             pattern=part.pattern, work=work)[1]
+
+    def work_stage5(engine, work):
+        return lambda: engine.stage_indices(plan.factors, plan.vertex_offsets, plan.index_offsets,
+                                            (0, plan.num_indices), (0, patches), kind=part.pattern,
+                                            out=triangles, work=work)[1]
+
+    for label, engine in engines.items():  # build every distribution's kernels now, from its tree
+        folder = Path(args.baseline_kernels) if label else kernel_dir()
+        saved, programs_module.kernel_dir = programs_module.kernel_dir, (lambda folder=folder: folder)
+        try:
+            for work in args.work:
+                work_stage4(engine, work)()[-1].wait()
+                work_stage5(engine, work)()[-1].wait()
+        finally:
+            programs_module.kernel_dir = saved
     forms = ("INTEL_FORMS",) if intel else ()
-    probe_source = PROBE.read_text()
-    probe = build(context, device, kernel_dir(), probe_source, "vertices", part.pattern, forms)
-    sink = build(context, device, kernel_dir(), probe_source, "vertices", part.pattern, forms + ("SINK_ONLY",))
-    lanes_stored = build(context, device, kernel_dir(), probe_source, "vertices", part.pattern, forms + ("STORE_LANES",))
+    if not args.no_probes:
+        probe_source = PROBE.read_text()
+        probe = build(context, device, kernel_dir(), probe_source, "vertices", part.pattern, forms)
+        sink = build(context, device, kernel_dir(), probe_source, "vertices", part.pattern, forms + ("SINK_ONLY",))
+        lanes_stored = build(context, device, kernel_dir(), probe_source, "vertices", part.pattern, forms + ("STORE_LANES",))
     octets = (16 - 1 + 7) // 8  # rows of a level-16 patch, 8 per work-item
 
     def launch_stage4(kernel):  # the engine's kernel takes its output's capacity (batch_fits); a tree before not
@@ -150,8 +185,8 @@ def main(argv=None) -> int:
                               plan.index_offsets.data, np.uint32(0), np.uint32(patches), np.uint64(0), *capacity,
                               triangles.data)
 
-    for rep in range(2):  # two rounds, interleaved, so that the load's drift touches every figure
-        suffix = "" if rep == 0 else " (again)"
+    for rep in range(args.rounds):  # rounds, interleaved, so that the load's drift touches every figure
+        suffix = "" if rep == 0 else " (again)" if rep == 1 else f" (round {rep + 1})"
         measure("fill" + suffix, lambda: fill(queue, (-(-count // 256) * 256,), (256,), fill_buffer,
                                               np.zeros(4, np.float32), np.uint64(count)))
         for label, (vertices_kernel, indices_kernel) in kernels.items():
@@ -159,6 +194,16 @@ def main(argv=None) -> int:
             record.setdefault("digests", {})[f"{label}stage 4"] = digest(out)
             measure(f"{label}stage 5 (indices){suffix}", launch_stage5(indices_kernel))
             record["digests"][f"{label}stage 5"] = digest([triangles])
+        for work in args.work:
+            for label, engine in engines.items():
+                for buffer in buffers + [triangles.data]:  # so that the digests show this launch's writes
+                    cl.enqueue_fill_buffer(queue, buffer, np.zeros(1, np.uint8), 0, buffer.size)
+                measure(f"{label}{work}: stage 4{suffix}", work_stage4(engine, work))
+                record["digests"][f"{label}{work}: stage 4{suffix}"] = digest(out)
+                measure(f"{label}{work}: stage 5{suffix}", work_stage5(engine, work))
+                record["digests"][f"{label}{work}: stage 5{suffix}"] = digest([triangles])
+        if args.no_probes:
+            continue
         for buffer in buffers:
             cl.enqueue_fill_buffer(queue, buffer, np.zeros(1, np.uint8), 0, buffer.size)
         measure(f"ring only{suffix}", launch_stage4(probe.ring_only))
@@ -180,7 +225,8 @@ def main(argv=None) -> int:
     record["load_after"] = [round(x, 1) for x in os.getloadavg()]
 
     def best(name, key):
-        return min(rows[n][key] for n in rows if n == name or n == name + " (again)")
+        return min(rows[n][key] for n in rows if n == name or n.startswith(name + " (again)")
+                   or n.startswith(name + " (round "))
 
     fill_device, fill_cpu = best("fill", "device_ms"), best("fill", "cpu_ms")
     lines = [f"{record['device']}; {patches:,} patches, {vertices:,} vertices, {plan.num_indices // 3:,} triangles, "
@@ -197,7 +243,11 @@ def main(argv=None) -> int:
     for label in kernels:
         written[f"{label}stage 4 (vertices)"] = written["stage 4 (vertices)"]
         written[f"{label}stage 5 (indices)"] = written["stage 5 (indices)"]
-    names = [n for n in rows if not n.endswith("(again)")]
+    for label in engines:
+        for work in args.work:
+            written[f"{label}{work}: stage 4"] = written["stage 4 (vertices)"]
+            written[f"{label}{work}: stage 5"] = written["stage 5 (indices)"]
+    names = [n for n in rows if not n.endswith("(again)") and " (round " not in n]
     for name in names:  # % of fill: the fill kernel's time for the bytes this kernel writes / its time
         device_ms, cpu_ms = best(name, "device_ms"), best(name, "cpu_ms")
         size = written.get(name)
@@ -210,13 +260,27 @@ def main(argv=None) -> int:
         cpu_ms = best(f"{label}stage 4 (vertices)", "cpu_ms") + best(f"{label}stage 5 (indices)", "cpu_ms")
         lines.append(f"| {label}stages 4 + 5 | {output_bytes / 1e6:.0f} | {device_ms:.1f} | {cpu_ms:.0f} | "
                      f"{100 * fill_device / device_ms:.1f}% | {100 * fill_cpu / cpu_ms:.1f}% |")
+    for work in args.work:
+        for label in engines:
+            device_ms = best(f"{label}{work}: stage 4", "device_ms") + best(f"{label}{work}: stage 5", "device_ms")
+            cpu_ms = best(f"{label}{work}: stage 4", "cpu_ms") + best(f"{label}{work}: stage 5", "cpu_ms")
+            lines.append(f"| {label}{work}: stages 4 + 5 | {output_bytes / 1e6:.0f} | {device_ms:.1f} | {cpu_ms:.0f} | "
+                         f"{100 * fill_device / device_ms:.1f}% | {100 * fill_cpu / cpu_ms:.1f}% |")
     lines += ["", "bits: " + ", ".join(f"{k} {v}" for k, v in record["digests"].items())]
     same = record["digests"]["stage 4"]
     soa8 = record["digests"].get("ring + rows_soa8")
-    lines.append(f"ring + rows same bits as stage 4: {'yes' if record['digests']['ring + rows'] == same else 'NO'}; "
-                 f"ring + rows_soa8 (Intel's forms): "
-                 f"{'not run (Intel only)' if soa8 is None else 'yes' if soa8 == same else 'NO'}; "
-                 f"ring_soa8 + rows_soa8: {'not run' if soa8 is None else 'yes' if record['digests']['ring_soa8 + rows_soa8'] == same else 'NO'}")
+    for work in args.work:
+        for label in engines:
+            lines.append(f"{label}{work} same bits as stages 4, 5 (patch), both rounds: " + ", ".join(
+                'yes' if record['digests'][f'{label}{work}: stage {stage}{suffix}'] == record['digests'][f'stage {stage}']
+                else 'NO' for stage in (4, 5) for suffix in ('', ' (again)')))  # the first two rounds
+    if args.no_probes:
+        lines.append("probes: not run (--no-probes)")
+    else:
+        lines.append(f"ring + rows same bits as stage 4: {'yes' if record['digests']['ring + rows'] == same else 'NO'}; "
+                     f"ring + rows_soa8 (Intel's forms): "
+                     f"{'not run (Intel only)' if soa8 is None else 'yes' if soa8 == same else 'NO'}; "
+                     f"ring_soa8 + rows_soa8: {'not run' if soa8 is None else 'yes' if record['digests']['ring_soa8 + rows_soa8'] == same else 'NO'}")
     print("\n".join(lines))
     if args.json:
         Path(args.json).write_text(json.dumps(record, indent=1, default=float) + "\n")

@@ -84,31 +84,79 @@ inline uint pattern_grid_index(pattern_grid g, int2 point)
 
 #include "patterns/stitch.h"
 
-/* Cells i0..i1-1 x j0..j1-1 of the grid, two triangles each; a triangle with a side on a
- * collapsed edge (bit e of collapsed) joins two coincident points and is left out.  A cell of
- * the inner grid (no corner on the ring) takes its corners' numbers directly: inner point
- * (i, j) is ring + (j - 1)(A - 1) + (i - 1) (pattern_grid_index), so its row neighbour is + 1
- * and the point above it + (A - 1); the same numbers as pattern_grid_index, with less work
- * (stage 5 on CPUs: bench/RESULTS.md, "Issue 15: CPU stage bandwidth"). */
+/* pattern_grid_index of a uniform grid (f = (A, B, A, B), core (A, B)), without ring_index's
+ * "% ring" (an integer division): there every point's ring number base + k is below the ring's
+ * 2A + 2B points (edge 0: i <= A; edge 1: A + j <= A + B; edge 2: A + B + (A - i) <= 2A + B;
+ * edge 3: 2A + B + (B - j) <= 2A + 2B - 1), so the remainder is the number itself.  Stage 5 of
+ * uniform level 16 on PoCL spent two thirds of its time in the ring's cells before this
+ * (bench/RESULTS.md, "PoCL's stages, session 7"). */
+inline uint uniform_grid_index(pattern_grid g, int2 point)
+{
+    int a = g.core.x, b = g.core.y, i = point.x, j = point.y;
+    if (j == 0) return (uint)i;                      /* ring_index(f, 0, i) */
+    if (i == a) return (uint)(a + j);                /* ring_index(f, 1, j) */
+    if (j == b) return (uint)(2 * a + b - i);        /* ring_index(f, 2, A - i) */
+    if (i == 0) return (uint)(2 * a + 2 * b - j);    /* ring_index(f, 3, B - j) */
+    return (uint)(2 * a + 2 * b) + (uint)(j - 1) * (uint)(a - 1) + (uint)(i - 1);
+}
+
+/* Cell (i, j) of the grid, two triangles (a, b, c), (a, c, d) with a = (i, j), b = (i + 1, j),
+ * c = (i + 1, j + 1), d = (i, j + 1); a triangle with a side on a collapsed edge (bit e of
+ * collapsed) joins two coincident points and is left out. */
+inline void grid_cell(__global uint *out, uint *count, uint base, pattern_grid g, int collapsed, int i, int j)
+{
+    uint a, b, c, d;
+    if (g.uniform) {
+        a = uniform_grid_index(g, (int2)(i, j));
+        b = uniform_grid_index(g, (int2)(i + 1, j));
+        c = uniform_grid_index(g, (int2)(i + 1, j + 1));
+        d = uniform_grid_index(g, (int2)(i, j + 1));
+    } else {
+        a = pattern_grid_index(g, (int2)(i, j));
+        b = pattern_grid_index(g, (int2)(i + 1, j));
+        c = pattern_grid_index(g, (int2)(i + 1, j + 1));
+        d = pattern_grid_index(g, (int2)(i, j + 1));
+    }
+    if (!((j == 0 && (collapsed & 1)) || (i + 1 == g.core.x && (collapsed & 2))))
+        put_triangle(out, count, base, a, b, c);
+    if (!((j + 1 == g.core.y && (collapsed & 4)) || (i == 0 && (collapsed & 8))))
+        put_triangle(out, count, base, a, c, d);
+}
+
+/* Cells i0..i1-1 x j0..j1-1 of the grid, row by row (grid_cell).  The cells of the inner grid
+ * (no corner on the ring: 0 < i < A - 1, 0 < j < B - 1) take their corners' numbers directly:
+ * inner point (i, j) is ring + (j - 1)(A - 1) + (i - 1) (pattern_grid_index), so its row
+ * neighbour is + 1 and the point above it + (A - 1); the same numbers as pattern_grid_index.
+ * A row's inner cells are one loop without branches or a running count, six indices a cell
+ * at out[3 count + 6 n ..] (so that a CPU compiler can unroll and vectorise it; stage 5 on
+ * CPUs: bench/RESULTS.md, "Issue 15: CPU stage bandwidth" and "PoCL's stages, session 7"). */
 inline void grid_cells(__global uint *out, uint *count, uint base, pattern_grid g, int collapsed,
                        int i0, int i1, int j0, int j1)
 {
     uint ring = (uint)(g.f.s0 + g.f.s1 + g.f.s2 + g.f.s3), inner = (uint)(g.core.x - 1);
-    for (int j = j0; j < j1; ++j)
-        for (int i = i0; i < i1; ++i) {
-            if (j > 0 && j + 1 < g.core.y && i > 0 && i + 1 < g.core.x) {
-                uint a = ring + (uint)(j - 1) * inner + (uint)(i - 1), d = a + inner;
-                put_triangle(out, count, base, a, a + 1, d + 1);  /* (a, b, c) */
-                put_triangle(out, count, base, a, d + 1, d);      /* (a, c, d) */
-                continue;
+    for (int j = j0; j < j1; ++j) {
+        int inner_row = j > 0 && j + 1 < g.core.y;
+        int lo = inner_row ? min(max(i0, 1), i1) : i1;  /* cells i0 .. lo - 1: on the ring (i = 0) */
+        int hi = inner_row ? max(lo, min(i1, g.core.x - 1)) : i1;  /* lo .. hi - 1 inner */
+        for (int i = i0; i < lo; ++i)
+            grid_cell(out, count, base, g, collapsed, i, j);
+        if (out) {
+            __global uint *cells = out + 3 * *count;
+            uint first = base + ring + (uint)(j - 1) * inner + (uint)(lo - 1);  /* base + a of cell lo */
+            for (int n = 0; n < hi - lo; ++n) {
+                uint a = first + (uint)n, d = a + inner;
+                cells[6 * n + 0] = a;      /* (a, b, c) */
+                cells[6 * n + 1] = a + 1;
+                cells[6 * n + 2] = d + 1;
+                cells[6 * n + 3] = a;      /* (a, c, d) */
+                cells[6 * n + 4] = d + 1;
+                cells[6 * n + 5] = d;
             }
-            uint a = pattern_grid_index(g, (int2)(i, j)), b = pattern_grid_index(g, (int2)(i + 1, j));
-            uint c = pattern_grid_index(g, (int2)(i + 1, j + 1)), d = pattern_grid_index(g, (int2)(i, j + 1));
-            if (!((j == 0 && (collapsed & 1)) || (i + 1 == g.core.x && (collapsed & 2))))
-                put_triangle(out, count, base, a, b, c);
-            if (!((j + 1 == g.core.y && (collapsed & 4)) || (i == 0 && (collapsed & 8))))
-                put_triangle(out, count, base, a, c, d);
         }
+        *count += 2 * (uint)(hi - lo);
+        for (int i = hi; i < i1; ++i)  /* on the ring (i = A - 1), or a row on it (j = 0, B - 1) */
+            grid_cell(out, count, base, g, collapsed, i, j);
+    }
 }
 
 /* Triangle t of a patch whose triangles are the plain A x B grid (uniform factors): *triangle
