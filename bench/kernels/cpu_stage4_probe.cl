@@ -59,7 +59,7 @@ __kernel void rows_only(__global const float4 *controls, __global const int4 *fa
     ulong at = vertex_offsets[p] - vertex_base;
     for (int e = 0; e < PATTERN_EDGES; ++e)
         at += (ulong)PATTERN_EDGE_POINTS(f, e);
-    put_rows(&patch, f, 1, pattern_rows(f), forward_differencing, out, at, p, patch_objects[p]);
+    put_rows(&patch, f, collapsed, 1, pattern_rows(f), forward_differencing, out, at, p, patch_objects[p]);
 }
 
 /* dot, cross and length of float3, lane by lane, as the runtime's builtins round them. */
