@@ -1,6 +1,7 @@
 """Issue 15, the CPU line: what bounds stages 4-5 on a CPU device, measured in one process.
 
-    python bench/cpu_stages.py [--device pocl] [--copies 1000] [--repeat 5] [--baseline-kernels DIR]
+    python bench/cpu_stages.py [--device pocl] [--copies 1000] [--repeat 5] [--rounds 2] [--baseline-kernels DIR]
+                               [--work patch rows-prep ...] [--local-sizes 1 8 64] [--scene KEY] [--no-probes]
                                [--json out.json]
 
 Uniform level 16 (``frame_loop.teapots``: 1,000 teapots, 32,000 patches, every edge factor
@@ -19,7 +20,17 @@ plan's device buffers, each kernel launched alone ``--repeat`` times:
   ring + rows, ring + rows_soa8 and ring_soa8 + rows_soa8 are hashed against the engine's stage 4
   ("same bits");
 * with ``--baseline-kernels DIR`` (a kernels/ folder of another tree, e.g. ``git archive`` of
-  main), its stage 4 and 5 built from there too, side by side.
+  main), its stage 4 and 5 built from there too, side by side;
+* with ``--work W ...``: stages 4 and 5 of each work distribution W (tessellator.py
+  ``WORK_DISTRIBUTIONS``) through the engine's own ``stage_vertices`` / ``stage_indices``
+  (a stage of several launches timed from the first one's start to the last one's end), from
+  this tree and, with ``--baseline-kernels``, from that one (a second Tessellator whose programs
+  are built from it), each hashed against the per-patch kernels' output ("same bits");
+* with ``--local-sizes N ...``: this tree's stage 4 and 5 kernels launched with work-group size
+  N too (the engine gives none, so the runtime picks);
+* ``--scene KEY``: a scene of the paper's suite (cltess.bench.suite, one kind) at its camera and
+  0.5 px instead of uniform level 16; ``--no-probes`` leaves the probes out; ``--rounds N``: N
+  interleaved rounds of every launch (the minimum over all of them is reported).
 
 Two clocks per launch: the device time (OpenCL profiling span: wall time on the runtime's
 threads, which this shared VM's load stretches) and the **process CPU time** (``getrusage``:
@@ -98,11 +109,14 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--device", help="OpenCL device (substring; default as cltess picks)")
     parser.add_argument("--copies", type=int, default=1000, help="teapots (32 patches each)")
+    parser.add_argument("--scene", help="a suite scene (cltess.bench.suite) at 0.5 px instead of uniform level 16")
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--baseline-kernels", help="a kernels/ folder to build stages 4-5 from too")
     parser.add_argument("--work", nargs="*", default=[],
                         help="work distributions (tessellator.py WORK_DISTRIBUTIONS) whose stages 4 and 5 to measure "
                              "through the engine's stage functions, from each tree")
+    parser.add_argument("--local-sizes", type=int, nargs="*", default=[],
+                        help="also launch this tree's stage 4 and 5 kernels with these work-group sizes (each divides 64)")
     parser.add_argument("--rounds", type=int, default=2, help="rounds of every launch, interleaved (at least 2)")
     parser.add_argument("--no-probes", action="store_true", help="leave out the stage 4 probes")
     parser.add_argument("--json")
@@ -113,8 +127,15 @@ def main(argv=None) -> int:
     intel = "Intel" in device.platform.name
     record = {"device": device_info(device), "machine": machine_info(), "command": " ".join(sys.argv),
               "date": time.strftime("%Y-%m-%d %H:%M:%S %z"), "load_before": [round(x, 1) for x in os.getloadavg()]}
-    scene = frame_loop.teapots(args.copies)
-    plan = tessellator.plan(scene, **frame_loop.uniform_request(16))
+    if args.scene:  # a scene of the paper's suite at its camera, 0.5 px (as bench/frame_loop.py)
+        scene = frame_loop.suite_scene(args.scene)
+        plan = tessellator.plan(scene, pixels=frame_loop.PIXELS)
+        if len(plan.parts) != 1:
+            parser.error(f"--scene {args.scene}: {len(plan.parts)} kinds; this script runs a scene of one")
+        record["scene"] = args.scene
+    else:
+        scene = frame_loop.teapots(args.copies)
+        plan = tessellator.plan(scene, **frame_loop.uniform_request(16))
     part = plan.parts[0]
     patches, vertices = plan.num_patches, plan.num_vertices
     output_bytes = vertices * 40 + plan.num_indices * 4
@@ -175,13 +196,13 @@ def main(argv=None) -> int:
         lanes_stored = build(context, device, kernel_dir(), probe_source, "vertices", part.pattern, forms + ("STORE_LANES",))
     octets = (16 - 1 + 7) // 8  # rows of a level-16 patch, 8 per work-item
 
-    def launch_stage4(kernel):  # the engine's kernel takes its output's capacity (batch_fits); a tree before not
+    def launch_stage4(kernel, local=None):  # the engine's kernel takes its output's capacity (batch_fits); a tree before not
         capacity = (np.uint64(vertices),) if kernel.num_args == len(common) + 1 + len(buffers) else ()
-        return lambda: kernel(queue, per_patch, None, *common, *capacity, *buffers)
+        return lambda: kernel(queue, per_patch, local, *common, *capacity, *buffers)
 
-    def launch_stage5(kernel):
+    def launch_stage5(kernel, local=None):
         capacity = (np.uint64(plan.num_indices),) if kernel.num_args == 8 else ()
-        return lambda: kernel(queue, per_patch, None, plan.factors.data, plan.vertex_offsets.data,
+        return lambda: kernel(queue, per_patch, local, plan.factors.data, plan.vertex_offsets.data,
                               plan.index_offsets.data, np.uint32(0), np.uint32(patches), np.uint64(0), *capacity,
                               triangles.data)
 
@@ -194,6 +215,12 @@ def main(argv=None) -> int:
             record.setdefault("digests", {})[f"{label}stage 4"] = digest(out)
             measure(f"{label}stage 5 (indices){suffix}", launch_stage5(indices_kernel))
             record["digests"][f"{label}stage 5"] = digest([triangles])
+        for local in args.local_sizes:  # this tree's kernels with a work-group size given (the engine gives none)
+            vertices_kernel, indices_kernel = kernels[""]
+            measure(f"stage 4 (vertices), local {local}{suffix}", launch_stage4(vertices_kernel, (local,)))
+            record["digests"][f"stage 4, local {local}"] = digest(out)
+            measure(f"stage 5 (indices), local {local}{suffix}", launch_stage5(indices_kernel, (local,)))
+            record["digests"][f"stage 5, local {local}"] = digest([triangles])
         for work in args.work:
             for label, engine in engines.items():
                 for buffer in buffers + [triangles.data]:  # so that the digests show this launch's writes
@@ -243,6 +270,9 @@ def main(argv=None) -> int:
     for label in kernels:
         written[f"{label}stage 4 (vertices)"] = written["stage 4 (vertices)"]
         written[f"{label}stage 5 (indices)"] = written["stage 5 (indices)"]
+    for local in args.local_sizes:
+        written[f"stage 4 (vertices), local {local}"] = written["stage 4 (vertices)"]
+        written[f"stage 5 (indices), local {local}"] = written["stage 5 (indices)"]
     for label in engines:
         for work in args.work:
             written[f"{label}{work}: stage 4"] = written["stage 4 (vertices)"]
@@ -269,6 +299,10 @@ def main(argv=None) -> int:
     lines += ["", "bits: " + ", ".join(f"{k} {v}" for k, v in record["digests"].items())]
     same = record["digests"]["stage 4"]
     soa8 = record["digests"].get("ring + rows_soa8")
+    for local in args.local_sizes:
+        lines.append(f"local {local} same bits as stages 4, 5: "
+                     f"{'yes' if record['digests'][f'stage 4, local {local}'] == same else 'NO'}, "
+                     f"{'yes' if record['digests'][f'stage 5, local {local}'] == record['digests']['stage 5'] else 'NO'}")
     for work in args.work:
         for label in engines:
             lines.append(f"{label}{work} same bits as stages 4, 5 (patch), both rounds: " + ", ".join(
