@@ -225,6 +225,7 @@ def main(argv=None) -> int:
             for label, engine in engines.items():
                 for buffer in buffers + [triangles.data]:  # so that the digests show this launch's writes
                     cl.enqueue_fill_buffer(queue, buffer, np.zeros(1, np.uint8), 0, buffer.size)
+                queue.finish()  # the baseline engine launches on its own queue: the fills must be done first
                 measure(f"{label}{work}: stage 4{suffix}", work_stage4(engine, work))
                 record["digests"][f"{label}{work}: stage 4{suffix}"] = digest(out)
                 measure(f"{label}{work}: stage 5{suffix}", work_stage5(engine, work))
