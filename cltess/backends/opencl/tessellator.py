@@ -81,12 +81,12 @@ LINE_WARPS_PER_UNIT = 8
 #: output vertices (counting its culled patches) ..., "point" otherwise (``Tessellator.auto_work``).
 #: rows-prep walks a row's points in order, so it gains with long rows and many patches; point
 #: spreads any patch over consecutive work-items, so it wins on the paper's scenes (3-22 vertices
-#: per patch, or the tea table's 70 on 332 patches); bench/RESULTS.md, "Issue 15: work="auto"
+#: per patch, or the tea table's 70 on 332 patches); bench/RESULTS.md, "Issue 15: stage 4 variants and work="auto"
 #: (session 7, branch gpu15e)".  On the H100 at 81 vertices per patch (uniform level 8) rows-prep
 #: took 0.203 ms against 0.219 on 3,200 patches and 0.424 against 1.342 on 32,000.
 AUTO_ROWS_MIN_VERTICES_PER_PATCH = 64
 #: ... and at least this many patches (a smaller batch gives rows-prep too few warps: on the H100
-#: 320 teapot patches at levels 12 and 16 took 0.15-0.17 ms against point's 0.09-0.10; 3,200
+#: 320 teapot patches at levels 12 and 16 took 0.15-0.18 ms against point's 0.09-0.10; 3,200
 #: took 0.20-0.35 against 0.22-0.42; measured at 320 and 3,200 only, the cut between them).
 AUTO_ROWS_MIN_PATCHES = 2048
 #: How stages 4-5 spread their work (docs/design.md, "Work distribution"): "patch" a work-item
