@@ -118,3 +118,14 @@ def test_direct_stage_calls_choose_by_their_batch(tessellator, auto, teapot, few
     assert len(events) == 2  # prepare_patches and prepared_rows: rows-prep
     assert np.array_equal(vertices["positions"].get(), expected.positions)
     assert np.array_equal(vertices["normals"].get(), expected.normals)
+
+
+@pytest.mark.parametrize("min_patches, made", [(16, True), (64, False)])
+def test_compose_makes_the_scratch_where_auto_may_prepare(auto, teapot, monkeypatch, min_patches, made):
+    """The prepared patches' scratch buffer is made before the plan's buffers (Oclgrind's
+    uninitialised-value pass, Tessellator.prepared_scratch) on scenes where auto may choose
+    rows-prep (at least AUTO_ROWS_MIN_PATCHES patches), not on others."""
+    from cltess.request import Request
+    monkeypatch.setattr(opencl, "AUTO_ROWS_MIN_PATCHES", min_patches)
+    auto.compose(teapot, Request.of(**UNIFORM))
+    assert (auto._prepared is not None) == made

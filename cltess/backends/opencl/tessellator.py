@@ -403,7 +403,8 @@ class Tessellator:
                 if self.tiled_offsets:
                     self.programs.kernel("offsets", "offsets_tiles", pattern=pattern)
                     self.programs.kernel("offsets", "offsets_carries", pattern=pattern)
-                if self.work.endswith("-prep"):  # before the plan's buffers (prepared_scratch)
+                may_prepare = self.work == "auto" and scene.num_patches >= AUTO_ROWS_MIN_PATCHES  # auto_work
+                if self.work.endswith("-prep") or may_prepare:  # before the plan's buffers (prepared_scratch)
                     self.prepared_scratch(kind, pattern, kind.count(scene))
                 if pattern.fixed_point:  # SD-2's level functions
                     build_level_function_programs(self)
