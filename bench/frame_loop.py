@@ -370,8 +370,8 @@ def output_digest(tess) -> str:
 #: "same bits" is among the ":direct" variants of the scene).
 VARIANTS = ["patch", "rows", "vertex", "point", "point/1", "point/16", "vertex-prep", "point-prep"]
 #: The GPU comparison of issue 15 (stage 4 from prepared patches), forward differencing on and off.
-GPU_VARIANTS = ["patch", "vertex", "point", "point/16", "vertex-prep", "point-prep", "point-prep/16",
-                "patch:direct", "vertex:direct", "point/16:direct", "vertex-prep:direct", "point-prep:direct",
+GPU_VARIANTS = ["patch", "vertex", "point", "point/16", "vertex-prep", "point-prep", "point-prep/16", "rows-prep",
+                "auto", "patch:direct", "vertex:direct", "point/16:direct", "vertex-prep:direct", "point-prep:direct",
                 "point-prep/16:direct"]
 
 

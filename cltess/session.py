@@ -134,6 +134,9 @@ class Session:
                 plan.settle()
             if plan.settled:
                 self.output.reserve(plan.num_vertices, plan.num_indices // 3)
+        settled = [plan for plan in self._plans if plan.settled]
+        if settled:  # work="auto" chooses by the latest settled frame (Tessellator.auto_work)
+            tessellator.note_plan(settled[-1])
         # The launches keep their arguments (the session's buffers): the next frame's launches
         # with the same ones only enqueue (programs.Kernel).  A new camera alone replays the last
         # frame recorded for these settings and buffers (recorded.py); any other frame is made
@@ -160,12 +163,13 @@ class Session:
 
     def _frame_key(self) -> tuple:
         """What a frame's launches depend on besides its camera: the tessellator's settings
-        that choose them (work distribution, records per work-item, patches per work-group,
+        that choose them (work distribution and, for work="auto", what it chooses now, records
+        per work-item, patches per work-group,
         stage 3's path) and the output buffers' capacity (they are only replaced when they grow)."""
         tessellator = self.tessellator
         return (tessellator.work, tessellator.records_per_item, tessellator.patches_per_group,
                 tessellator.fused_offsets, tessellator.tiled_offsets, tessellator.one_scan, tessellator._cpu,
-                self.output.capacity)
+                tessellator.auto_work(), self.output.capacity)
 
     def __repr__(self) -> str:
         return (f"Session({self.scene.name!r}, {self.device.name.strip()!r}, {self.frames} frames, "

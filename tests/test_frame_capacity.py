@@ -11,7 +11,7 @@ from cltess.backends.opencl import tessellator as opencl
 from cltess.tessellation import StaleOutput, VERTEX_RECORD
 from support import assert_same_output
 
-WORKS = ["patch", "rows", "point", "point-prep", "rows-prep"]
+WORKS = ["patch", "rows", "point", "point-prep", "rows-prep", "auto"]
 SENTINEL = 0xA5  # every byte of the output buffers before a launch
 
 

@@ -15,7 +15,7 @@ from cltess.scene import Camera
 from support import assert_same_output
 
 #: (work, stage 3 as on a GPU): the CPU's own path and a GPU's (stage 3 in one launch, or in two)
-PATHS = [("patch", False), ("point", True), ("rows-prep", True)]
+PATHS = [("patch", False), ("point", True), ("rows-prep", True), ("auto", True)]
 
 
 def gpu_like(tessellator, work: str, as_gpu: bool, tiled: bool = False):

@@ -75,7 +75,8 @@ ulong flag_counts(int flag) {{ return (ulong)((flag & FLAG_CULLED) != 0) | ((ulo
 #: (tessellator.py WORK_DISTRIBUTIONS).
 WORK_STAGES = {"rows": ("vertex_rows",), "vertex": ("vertex_points",), "point": ("vertex_points", "triangles"),
                "vertex-prep": ("prepared_points",), "point-prep": ("prepared_points", "triangles"),
-               "rows-prep": ("prepared_points", "triangles")}
+               "rows-prep": ("prepared_points", "triangles"),
+               "auto": ("vertex_points", "prepared_points", "triangles")}
 
 
 def same_arguments(args: tuple, kept: tuple | None) -> bool:

@@ -71,6 +71,24 @@ LINE_GROUP = 32
 #: A scene of few patches gets few work-groups: "rows-prep" is for scenes of large patches.
 LINE_PATCHES = 32
 LINE_MAX_PATCHES = 64
+#: "rows-prep" on a batch of fewer patches than LINE_PATCHES per warp for LINE_WARPS_PER_UNIT warps
+#: of every compute unit: fewer patches per work-group (``line_patches_for``), so that the
+#: batch still spreads over the whole device.  A warp walks its group's lines in turn (latency-
+#: bound: 255 registers on the H100 leave 8 warps per SM), so a scene of few patches in groups of
+#: 32 left most of the device idle (the tea table's 332 patches: 11 warps).
+LINE_WARPS_PER_UNIT = 8
+#: work="auto" (the GPU default): "rows-prep" for a batch whose patches average at least this many
+#: output vertices (counting its culled patches) ..., "point" otherwise (``Tessellator.auto_work``).
+#: rows-prep walks a row's points in order, so it gains with long rows and many patches; point
+#: spreads any patch over consecutive work-items, so it wins on the paper's scenes (3-22 vertices
+#: per patch, or the tea table's 70 on 332 patches); bench/RESULTS.md, "Issue 15: stage 4 variants and work="auto"
+#: (session 7, branch gpu15e)".  On the H100 at 81 vertices per patch (uniform level 8) rows-prep
+#: took 0.203 ms against 0.219 on 3,200 patches and 0.424 against 1.342 on 32,000.
+AUTO_ROWS_MIN_VERTICES_PER_PATCH = 64
+#: ... and at least this many patches (a smaller batch gives rows-prep too few warps: on the H100
+#: 320 teapot patches at levels 12 and 16 took 0.15-0.18 ms against point's 0.09-0.10; 3,200
+#: took 0.20-0.35 against 0.22-0.42; measured at 320 and 3,200 only, the cut between them).
+AUTO_ROWS_MIN_PATCHES = 2048
 #: How stages 4-5 spread their work (docs/design.md, "Work distribution"): "patch" a work-item
 #: per patch (stages/vertices.cl, stages/indices.cl); "rows" stage 4 a work-item per (patch,
 #: row) (stages/vertex_rows.cl), stage 5 per patch; "vertex" stage 4 a work-item per output
@@ -83,13 +101,18 @@ LINE_MAX_PATCHES = 64
 #: "rows-prep": stage 4 a work-item per interior row or ring edge of prepared patches, its points
 #: walked in order (one forward-differencing step each) and staged in local memory to be written
 #: side by side (stages/prepared_points.cl prepared_rows); stage 5 a work-item per triangle.
-WORK_DISTRIBUTIONS = ("patch", "rows", "vertex", "point", "vertex-prep", "point-prep", "rows-prep")
+#: "auto": "rows-prep" or "point" for each frame, by its vertices per patch (AUTO_ROWS_MIN_VERTICES_PER_PATCH).
+WORK_DISTRIBUTIONS = ("patch", "rows", "vertex", "point", "vertex-prep", "point-prep", "rows-prep", "auto")
+#: What work="auto" chooses between.
+AUTO_WORK = ("point", "rows-prep")
 #: The default per device type, chosen by bench/frame_loop.py --work gpu (bench/RESULTS.md, "Issue
 #: 15: the work distributions on the H100"): CPUs keep a patch per work-item (the point kernels
 #: replay forward differencing per vertex: more arithmetic, which a CPU pays); GPUs a work-item
 #: per vertex and triangle ("point": fastest or within 20% of the fastest on the paper's scenes
 #: on the H100; "point-prep" wins only where patches have hundreds of vertices, uniform level 16).
-DEFAULT_WORK = {"gpu": "point", "other": "patch"}
+#: Since session 7: GPUs "auto" ("point" on the paper's scenes, "rows-prep" where patches have
+#: hundreds of vertices).
+DEFAULT_WORK = {"gpu": "auto", "other": "patch"}
 
 
 #: Stage 3 in one launch per range of patches (stages/offsets.cl: counts and the scan by one
@@ -248,7 +271,8 @@ class Tessellator:
         self.device = device if isinstance(device, cl.Device) else pick_device(device)
         self.one_scan = os.environ.get("CLTESS_ONE_SCAN", "1") != "0"  # stage 3: one scan, else two
         self.records_per_item = None  # stages/vertex_points.cl, triangles.cl: None is RECORDS_PER_ITEM
-        self.patches_per_group = None  # work="rows-prep": None is LINE_PATCHES
+        self.patches_per_group = None  # work="rows-prep": None is line_patches_for the batch
+        self._batch_seen = None  # work="auto": the latest settled plan's (vertices, patches) (note_plan)
         self.work = "rows" if rows_in_parallel else work or default_work(self.device)
         if self.work not in WORK_DISTRIBUTIONS:
             raise ValueError(f"work={self.work!r}: expected one of {', '.join(WORK_DISTRIBUTIONS)}")
@@ -277,6 +301,43 @@ class Tessellator:
         if self.records_per_item:
             return self.records_per_item
         return RECORDS_PER_ITEM_PREPARED if work in PREPARED_WORK else RECORDS_PER_ITEM
+
+    def note_plan(self, plan: "Plan", first: int = 0, last: int | None = None) -> None:
+        """Keep a settled plan's (vertices, patches) of patches first .. last-1 (culled ones
+        counted) for work="auto" (``auto_work``); an unsettled plan is ignored."""
+        last = plan.num_patches if last is None else last
+        if plan.settled and last > first:
+            start, stop = plan.vertex_range(first, last)
+            self._batch_seen = (stop - start, last - first)
+
+    def auto_work(self, vertices: int | None = None, patches: int | None = None) -> str:
+        """The work distribution that work="auto" runs for a batch of ``vertices`` on
+        ``patches`` (both, or neither: then the latest plan given to ``note_plan``, "point"
+        before any): "rows-prep" where the batch has at least ``AUTO_ROWS_MIN_PATCHES`` patches
+        averaging at least ``AUTO_ROWS_MIN_VERTICES_PER_PATCH`` vertices, else "point".  Any
+        other ``work`` is returned as it is."""
+        if self.work != "auto":
+            return self.work
+        if vertices is None or patches is None:
+            if self._batch_seen is None:
+                return "point"
+            vertices, patches = self._batch_seen
+        if patches >= AUTO_ROWS_MIN_PATCHES and vertices >= AUTO_ROWS_MIN_VERTICES_PER_PATCH * patches:
+            return "rows-prep"
+        return "point"
+
+    def line_patches_for(self, patches: int) -> int:
+        """Patches per work-group of "rows-prep" for a batch of ``patches``: ``patches_per_group``
+        if set; else LINE_PATCHES where that gives at least half of LINE_WARPS_PER_UNIT
+        work-groups (one warp each) per compute unit, and fewer, to give about
+        LINE_WARPS_PER_UNIT, on a smaller batch.  (On the H100, uniform level 16 on 32,000
+        patches: 31 per group, 1,033 warps, took 0.548 ms against 32's 0.508, 1,000 warps.)"""
+        if self.patches_per_group:
+            return self.patches_per_group
+        groups = LINE_WARPS_PER_UNIT * self.device.max_compute_units
+        if 2 * -(-patches // LINE_PATCHES) >= groups:
+            return LINE_PATCHES
+        return max(1, min(LINE_PATCHES, -(-patches // groups)))
 
     @property
     def rows_in_parallel(self) -> bool:
@@ -342,7 +403,8 @@ class Tessellator:
                 if self.tiled_offsets:
                     self.programs.kernel("offsets", "offsets_tiles", pattern=pattern)
                     self.programs.kernel("offsets", "offsets_carries", pattern=pattern)
-                if self.work.endswith("-prep"):  # before the plan's buffers (prepared_scratch)
+                may_prepare = self.work == "auto" and scene.num_patches >= AUTO_ROWS_MIN_PATCHES  # auto_work
+                if self.work.endswith("-prep") or may_prepare:  # before the plan's buffers (prepared_scratch)
                     self.prepared_scratch(kind, pattern, kind.count(scene))
                 if pattern.fixed_point:  # SD-2's level functions
                     build_level_function_programs(self)
@@ -540,6 +602,10 @@ class Tessellator:
             index_range = plan.index_range(first, last)
         else:  # on the buffers' capacity; PendingEmit.result runs them again if it was too small
             vertex_range, index_range = (0, capacity[0]), (0, 3 * capacity[1])
+        work = self.work
+        if work == "auto":  # by this plan's vertices per patch where known, else by the latest settled plan's
+            self.note_plan(plan, first, last)
+            work = self.auto_work()
         events = dict(plan.events) if first == 0 else {}
         arrays = buffers.take(vertex_range[1] - vertex_range[0], (index_range[1] - index_range[0]) // 3)
         vertices = {name: arrays.raw(name) for name, _, _ in VERTEX_RECORD}
@@ -551,10 +617,10 @@ class Tessellator:
             events["vertices"] += self.stage_vertices(
                 part.data["controls"], plan.factors, plan.vertex_offsets, plan.objects, vertex_range,
                 (lo, hi), forward_differencing, kind=part.kind, patch_base=part.base, out=vertices,
-                pattern=part.pattern)[1]
+                pattern=part.pattern, work=work)[1]
             events["indices"] += self.stage_indices(
                 plan.factors, plan.vertex_offsets, plan.index_offsets, index_range, (lo, hi),
-                kind=part.pattern, out=arrays.raw("triangles"))[1]
+                kind=part.pattern, out=arrays.raw("triangles"), work=work)[1]
         strips = None
         if plan.strip_offsets is not None:
             strips, events["strips"] = emit_strips(self, plan, first, last)
@@ -842,6 +908,8 @@ class Tessellator:
                      np.uint32(last - first), np.uint32(patch_base), np.uint64(vertex_range[0]),
                      np.int32(forward_differencing), np.uint64(vertex_range[1] - vertex_range[0]))
         work = work or self.work
+        if work == "auto":  # called directly (levels.py): by this batch's vertices per patch
+            work = self.auto_work(vertex_range[1] - vertex_range[0], last - first)
         if rows_per_patch is None and work == "rows":
             rows_per_patch = MAX_ROWS_PER_PATCH
         if rows_per_patch is None and work in PREPARED_WORK:
@@ -891,7 +959,7 @@ class Tessellator:
             self.queue, _global_size(last - first), None, controls.data, vertex_offsets.data, np.uint32(first),
             np.uint32(last - first), np.uint32(patch_base), self._prepared)
         if work == "rows-prep":
-            per_group = self.patches_per_group or LINE_PATCHES
+            per_group = self.line_patches_for(last - first)
             if not 0 < per_group <= LINE_MAX_PATCHES:
                 raise ValueError(f"patches_per_group={per_group}: expected 1 .. {LINE_MAX_PATCHES}")
             rows = self.programs.kernel("prepared_points", "prepared_rows", **program)(
@@ -924,6 +992,8 @@ class Tessellator:
         arguments = (factors.data, vertex_offsets.data, index_offsets.data, np.uint32(first),
                      np.uint32(last - first), np.uint64(index_range[0]), np.uint64(n))
         work = work or self.work
+        if work == "auto":  # called directly (levels.py, silhouette.py): "point" or "rows-prep", both per triangle
+            work = self.auto_work()
         if work in ("point", "point-prep", "rows-prep"):  # work-items past the part's triangles stop
             per_item = self.records_for(work)
             event = self.programs.kernel("triangles", pattern=_pattern(kind))(
