@@ -9,6 +9,8 @@ factor 1 (the grid of 1 against the grid of 41).  NumPy only.
 departures: leaving the plateau of n (all phi = n) with the tip rising by d and its c+2 at q of
   that rate (lam = 1 - q): the move in the first 1/64 of a factor unit, and the fastest move per
   factor unit over d in [0, 1) (uniform refinement from 1: 0.96 errors per unit).
+sequential: leaving the plateau of 3 or 5 with c+2 following after a delay (the generic way: one corner
+  after the other): the worst move at two step sizes (seventh pass).
 triple: a loop of radius r factor units around a triple tie at factor n (phi_k = n + r cos(theta
   + 2 pi k / 3), 72 angles): its diameter (the largest distance between two of its meshes, each
   against every sixth other).  A pop at the triple point: the diameter does not shrink with r.
@@ -63,15 +65,32 @@ def triple(factors=(1.05, 1.2, 1.5, 2.0, 3.05), radii=(0.02, 0.005)):
               + " of the factor-1 error", flush=True)
 
 
+def sequential(plateaus=(3, 5), rates=(0.3, 0.75), delays=(0.0, 0.005, 0.02), steps=(0.02, 0.01)):
+    """Leaving the plateau of n with the tip rising by d and its c+2 following at q of that rate
+    after a delay d0 (d0 = 0: both at once; the generic way, one corner after the other, passes
+    the plateau's corner at rho = d0): the worst move over d in [0, 0.2) at each step size."""
+    for n in plateaus:
+        error = model.plateau_error(n)
+        for q in rates:
+            for d0 in delays:
+                at = lambda d: record([n + d, n, n + q * max(d - d0, 0.0)])
+                worst = [max(model.lifted_distance(at(d), at(d + h)) for d in np.arange(0.0, 0.2, h)) / error
+                         for h in steps]
+                print(f"plateau {n}, c+2 at {q} after {d0}: worst step " +
+                      " / ".join(f"{x:.3f}" for x in worst) + f" of its error at steps {steps}", flush=True)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("part", nargs="?", choices=("departures", "triple", "both"), default="both")
+    parser.add_argument("part", nargs="?", choices=("departures", "triple", "sequential", "both"), default="both")
     args = parser.parse_args()
     print(f"tree {TREE}")
     if args.part in ("departures", "both"):
         departures()
     if args.part in ("triple", "both"):
         triple()
+    if args.part == "sequential":
+        sequential()
 
 
 if __name__ == "__main__":

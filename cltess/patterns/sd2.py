@@ -84,8 +84,11 @@ def sd2_morph(f, c: int) -> tuple[bool, np.float32, np.float32]:
     c+2, ``min(e2 / e1, 1)``, e_k = F - phi_k the distance of base corner k from tying with the
     tip: 1 at e1 = 0, 0 at e2 = 0, continuous elsewhere, and 1 when the base corners tie with each
     other (e1 = e2: a plateau left by the tip starts from the tie configuration with partner c+1,
-    which at an odd whole factor is the plateau's grid).  Outside the zone, or without a usable
-    hint: (False, 1, 1)."""
+    which at an odd whole factor is the plateau's grid); then sharpened about 1/2 near a triple
+    tie at an odd whole factor of 3 or more (_sharpen to width _switch_width; docs/sd2.md
+    section 5, "Seventh pass"), where a blend of the two configurations slides each vertex by up to
+    n lattice cells while the configurations themselves are nearly the same lattice.  Outside the
+    zone, or without a usable hint: (False, 1, 1)."""
     one = np.float32(1.0)
     hint = sd2_hint(f)
     big, base = int(f[c]), int(f[(c + 1) % 3])
@@ -96,7 +99,54 @@ def sd2_morph(f, c: int) -> tuple[bool, np.float32, np.float32]:
     e1, e2 = (e_m, e_other) if m == (c + 1) % 3 else (e_other, e_m)
     w = np.float32(e_other) * np.float32(1.0 / FIXED_ONE)
     lam = min(np.float32(np.float32(e2) / np.float32(e1)), np.float32(1.0)) if e1 > 0 else np.float32(1.0)
-    return True, w, lam
+    return True, w, _sharpen(lam, _switch_width(big, phi_m))
+
+
+def odd_distance(x: int) -> int:
+    """The distance (16.16) of a fixed-point factor from the nearest odd whole number (where
+    fractional_odd places its points at k / n and every tie configuration is the regular lattice).
+    Device: sd2.h sd2_odd_distance, the same integer operations."""
+    r = abs(int(x) - FIXED_ONE) % (2 * FIXED_ONE)
+    return min(r, 2 * FIXED_ONE - r)
+
+
+#: How close (factor units) to a triple tie at an odd whole number the zone switches between its
+#: two tie configurations instead of blending them (docs/sd2.md section 5, "Seventh pass"): the
+#: switch's width kappa grows as rho / SWITCH_REACH.  Device: sd2.h SD2_SWITCH_REACH.
+SWITCH_REACH = 0.125
+
+
+def _switch_width(big: int, phi_m: int) -> np.float32:
+    """kappa, the width in lam over which the zone moves from one tie configuration to the other
+    (docs/sd2.md section 5, "Seventh pass"): ``min(1, max(rho / SWITCH_REACH, sigma_m / rho))``,
+    rho = F - phi_m the distance from the triple tie, sigma_m the distance of phi_m from the nearest
+    odd whole number.  Small only near a triple tie at an odd whole number (rho and sigma_m both
+    small), where the two tie configurations are within O(rho + sigma_m) of the same lattice as
+    surfaces while any blend of them stands off both by about the error; 1 (lam itself) elsewhere,
+    near isolated triple ties off the odd numbers included, and below phi_m = 2, where the
+    plateau of 1's blends already move in proportion (their centres on the chord, sixth pass) and a
+    steeper lam would only move them faster (kappa is 1 near phi_m = 2 either way).  Device: sd2.h sd2_switch_width, the
+    same operations."""
+    rho = int(big) - int(phi_m)
+    if rho <= 0 or phi_m < 2 * FIXED_ONE:
+        return np.float32(1.0)
+    apart = np.float32(np.float32(odd_distance(phi_m)) / np.float32(rho))
+    from_tie = np.float32(np.float32(np.float32(rho) * np.float32(1.0 / FIXED_ONE)) / np.float32(SWITCH_REACH))
+    return min(np.float32(1.0), max(from_tie, apart))
+
+
+def _sharpen(lam: np.float32, kappa: np.float32) -> np.float32:
+    """lam steepened about 1/2 to width kappa: ``clamp(1/2 + (lam - 1/2) / kappa, 0, 1)``
+    (kappa = 1: lam itself, bitwise; kappa = 0: the step, 1 from lam = 1/2 on).  0 and 1 are kept, so the
+    ties (lam 1 at e1 = 0, 0 at e2 = 0) and the plateau's lam = 1 are unchanged.  Device: sd2.h
+    sd2_sharpen, the same operations."""
+    half, zero, one = np.float32(0.5), np.float32(0.0), np.float32(1.0)
+    if kappa >= one:
+        return lam
+    d = np.float32(lam - half)
+    if kappa <= zero:
+        return one if d >= zero else zero
+    return min(max(np.float32(half + np.float32(d / kappa)), zero), one)
 
 
 def _fan_z(t: np.float32, s: np.float32, w: np.float32, lam: np.float32) -> np.float32:

@@ -75,10 +75,53 @@ inline int sd2_hint(int4 f, int *m, int *phi)
     return h > 0 && *m < 3;
 }
 
+/* The distance (16.16) of a fixed-point factor from the nearest odd whole number (mirror
+ * odd_distance, the same integer operations). */
+inline int sd2_odd_distance(int x)
+{
+    int r = abs(x - FIXED_ONE) % (2 * FIXED_ONE);
+    return min(r, 2 * FIXED_ONE - r);
+}
+
+/* kappa, the width in lam over which the zone moves from one tie configuration to the other
+ * (docs/sd2.md section 5, "Seventh pass"; mirror _switch_width, the same operations):
+ * min(1, max(rho / SD2_SWITCH_REACH, sigma_m / rho)), rho = F - phi_m the distance from the triple
+ * tie, sigma_m that of phi_m from the nearest odd whole number: small only near a triple tie at an
+ * odd whole number, where the two tie configurations are within O(rho + sigma_m) of one lattice as
+ * surfaces and any blend of them stands off both by about the error; 1 elsewhere.  The reach is
+ * pinned equal to the mirror's SWITCH_REACH by tests/contracts/test_constants.py. */
+#define SD2_SWITCH_REACH 0.125f
+inline float sd2_switch_width(int big, int phi_m)
+{
+    int rho = big - phi_m;
+    if (rho <= 0 || phi_m < 2 * FIXED_ONE)  /* the plateau of 1 moves in proportion already */
+        return 1.0f;
+    float apart = (float)sd2_odd_distance(phi_m) / (float)rho;
+    float from_tie = (float)rho * (1.0f / (float)FIXED_ONE) / SD2_SWITCH_REACH;
+    return fmin(1.0f, fmax(from_tie, apart));
+}
+
+/* lam steepened about 1/2 to width kappa (mirror _sharpen, the same operations):
+ * clamp(1/2 + (lam - 1/2) / kappa, 0, 1); kappa = 0: the step, 1 from lam = 1/2 on.  0 and 1 are
+ * kept, so ties and plateaus keep their configuration. */
+inline float sd2_sharpen(float lam, float kappa)
+{
+    if (kappa >= 1.0f)
+        return lam;
+    float d = lam - 0.5f;
+    if (kappa <= 0.0f)
+        return d >= 0.0f ? 1.0f : 0.0f;
+    float x = d / kappa;
+    float y = 0.5f + x;
+    return fmin(fmax(y, 0.0f), 1.0f);
+}
+
 /* The tie zone of the fan with tip c (mirror sd2_morph): 1 when in it, with *w the radial
  * pattern's weight (F - G) / 1.0 and *lam the weight of the tie with partner c+1,
  * min(e2 / e1, 1), e_k = F - phi_k (1 when the base corners tie with each other: a plateau left
- * by the tip starts from one tie configuration, docs/sd2.md section 5). */
+ * by the tip starts from one tie configuration, docs/sd2.md section 5), sharpened about 1/2 near a
+ * triple tie at an odd whole factor of 3 or more (sd2_sharpen to width sd2_switch_width; section 5,
+ * "Seventh pass"). */
 inline int sd2_morph(int4 f, int c, float *w, float *lam)
 {
     int m, phi_m;
@@ -90,7 +133,8 @@ inline int sd2_morph(int4 f, int c, float *w, float *lam)
     int e_m = big - phi_m, e_other = big - base;
     int e1 = m == (c + 1) % 3 ? e_m : e_other, e2 = m == (c + 1) % 3 ? e_other : e_m;
     *w = (float)e_other * (1.0f / (float)FIXED_ONE);
-    *lam = e1 > 0 ? fmin((float)e2 / (float)e1, 1.0f) : 1.0f;
+    float ratio = e1 > 0 ? fmin((float)e2 / (float)e1, 1.0f) : 1.0f;
+    *lam = sd2_sharpen(ratio, sd2_switch_width(big, phi_m));
     return 1;
 }
 

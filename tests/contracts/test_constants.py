@@ -84,6 +84,7 @@ def test_the_sd2_zone_constants_equal_the_mirrors():
 
     found = defines("patterns/sd2.h")
     assert found["SD2_HINT_SHIFT"] == sd2.HINT_SHIFT
+    assert np.float32(found["SD2_SWITCH_REACH"]) == np.float32(sd2.SWITCH_REACH)
 
 
 def test_the_error_hull_constants_equal_the_mirror():

@@ -57,6 +57,10 @@ def random_fixed_factors(rng, count, high=40):
                max(top - int(rng.integers(0, 4 * FIXED_ONE)), FIXED_ONE)]
         if rng.random() < 0.3:  # the base corners tied with each other (a plateau left by the tip)
             phi[2] = phi[1]
+        elif rng.random() < 0.3:  # an odd plateau of 3 or more left by two corners (docs/sd2.md section 5,
+            plateau = int(2 * rng.integers(1, max(high // 2, 2)) + 1) * FIXED_ONE  # "Seventh pass": lam sharpened)
+            d = int(rng.integers(0, FIXED_ONE // 4))
+            phi = [plateau + d, plateau + int(rng.integers(0, d + 1)), plateau]
         phi = [phi[k] for k in rng.permutation(3)]
         m = int(np.argmin(phi))
         factors[p] = [max(phi[e], phi[(e + 1) % 3]) for e in range(3)] + [(phi[m] << HINT_SHIFT) | m]
