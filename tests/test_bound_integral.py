@@ -49,6 +49,31 @@ def test_host_and_device_constants_agree():
     assert all(b == 2 * a for a, b in zip(k, k[1:]))
 
 
+def test_cell_forms_equal_a_cell_by_cell_computation(rng):
+    """cell_forms (component-major, vectorised over cells) against each cell's nets restricted
+    one at a time and quartic_coefficients, the formula it states: equal to float64 rounding
+    (QUARTIC_PAD's margin is 1e-12 of each column's size; the two differ by ~1e-16 of it)."""
+    breaks = np.array([0.0, 0.125, 0.4, 0.5, 1.0])
+    matrices = integral.interval_matrices(breaks)
+    for patch in random_patches(rng, 3):
+        forms = integral.cell_forms(patch, breaks)
+        numerators, cube = integral.numerator_nets(patch)
+        nets = np.concatenate([numerators.reshape(10, 10, 9), cube[..., None]], axis=-1)  # [j, i, c]
+        for t in range(len(breaks) - 1):
+            for u in range(len(breaks) - 1):
+                cell = np.einsum("bj,ai,jic->bac", matrices[t], matrices[u], nets).reshape(100, 10)
+                h = (cell[:, :9] / cell[:, 9:]).reshape(100, 3, 3)
+                norms = np.linalg.norm(h, axis=-1)
+                e = integral.quartic_coefficients(h[:, 0], h[:, 1], h[:, 2])
+                expected = [*norms.max(axis=0), e[:, 2].max(), e[:, 1].max(), -e[:, 1].min(), e[:, 3].max(),
+                            -e[:, 3].min()]
+                size = [(2 * norms[:, 0] * norms[:, 2] + 4 * norms[:, 1] ** 2).max()] * 2 + \
+                    [(4 * norms[:, 0] * norms[:, 1]).max()] * 2 + [(4 * norms[:, 1] * norms[:, 2]).max()] * 2
+                scale = np.concatenate([norms.max(axis=0), size])
+                got = forms[t, u] - np.concatenate([[0, 0, 0], integral.QUARTIC_PAD * np.array(size)[[0, 2, 2, 4, 4]]])
+                assert np.all(np.abs(got - expected) <= 1e-14 * scale[:8]), (t, u)
+
+
 def test_subpatch_majorants_hold_and_pyramid_bounds_them(rng):
     sys.path.insert(0, str(SCENES.parent / "bench"))
     from ratio_floor import second_derivatives

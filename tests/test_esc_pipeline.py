@@ -169,7 +169,7 @@ def test_stage_1_on_random_patches_equals_the_mirror_but_at_the_threshold(tessel
     eps (where float32 may round either way)."""
     from cltess.scene import Scene
     from support import random_patches
-    patches = random_patches(rng, 300, spread=1.0).astype(np.float32).astype(np.float64)
+    patches = random_patches(rng, 150, spread=1.0).astype(np.float32).astype(np.float64)
     scene = Scene(patches, np.zeros(len(patches), np.int32), name="random")
     for eps in (3e-3, 3e-2):
         request = Request.of(eps=eps, pattern="esc")

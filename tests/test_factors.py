@@ -26,7 +26,7 @@ def assert_factors_match(got, expected, unclamped, rounding=1e-4):
 
 @pytest.mark.parametrize("eps", [0.03, 0.2, 1.0])
 def test_factors_match_reference_on_random_rational_patches(tessellator, rng, eps):
-    patches = random_patches(rng, 3000)
+    patches = random_patches(rng, 1000)
     got, flags = device_factors(tessellator, patches, eps=eps)
     expected, unclamped, saturated = reference.zs_factors(as_float32(patches),
                                                            reference.patch_factor_tolerances(as_float32(patches), eps)[0])
@@ -45,7 +45,7 @@ def test_saturated_patches_are_flagged_and_clamped(tessellator, rng):
 
 
 def test_screen_space_tolerance_and_culling_match_reference(tessellator, rng):
-    patches = random_patches(rng, 3000)
+    patches = random_patches(rng, 1000)
     camera = Camera(eye=np.array([20.0, 3.0, 1.0]), target=np.zeros(3), fov_y_deg=40)
     got, flags = device_factors(tessellator, patches, pixels=0.5, camera=camera, max_factor=4096)
     eps, culled = reference.patch_factor_tolerances(as_float32(patches), pixels=0.5, camera=camera)

@@ -187,9 +187,13 @@ def test_scenarios_reach_every_code_path(oclgrind, tmp_path_factory):
     for name in ("collapsed_lid", "collapsed_bottom_direct", "esc_sphere_poles"):
         scene, _ = scenarios.SCENARIOS[name]()
         assert edge_groups(scene.patches).collapsed > 0, name
-    integral = stats["integral_bound"]  # stages/integral_bound.cl ran, and a trial was taken back
+    # stages/integral_bound.cl ran on a rational patch's triangles beside unchecked ones (one round:
+    # a second would run its K of 24 on the failing triangles, minutes at -O0; the trial loop it
+    # shares, plan_trials, takes a trial back in error_hull_bound below)
+    integral = stats["integral_bound"]
     ring = factors["integral_bound"]
-    assert integral["integral_rounds"] >= 2 and integral["integral_checked"] > 0
+    assert integral["integral_rounds"] >= 1 and integral["integral_checked"] > 0
+    assert integral["integral_patches"] == 1 and integral["patches"] == 2
     assert ((ring[:, 0] != ring[:, 2]) | (ring[:, 1] != ring[:, 3])).any(), "integral: transition triangles"
     hull = stats["error_hull_bound"]  # stages/error_hull_bound.cl ran, and a trial was taken back
     ring = factors["error_hull_bound"]

@@ -188,24 +188,33 @@ def cell_forms(patch: np.ndarray, breaks: np.ndarray) -> np.ndarray:
     nets = np.concatenate([numerators.reshape(10, 10, 9), cube[..., None]], axis=-1)  # [j, i, c]
     matrices = interval_matrices(breaks)
     along_u = np.einsum("sai,jic->sjac", matrices, nets)  # [u piece, j, i', c]
+    # Component-major, [c, u piece, j, i'], so that after the v step a cell's 100 control points
+    # are the last, contiguous axis: the dot products and maxima below then run 3x faster than
+    # over [.., 3, 3] vectors (quartic_coefficients' layout; 0.3 s a patch instead of 0.9).
+    components = np.ascontiguousarray(along_u.transpose(3, 0, 1, 2))
     out = np.empty((pieces, pieces, TABLE_WIDTH))
-    for t in range(pieces):  # one v piece at a time: (S, 10, 10, 10) floats
-        sub = np.einsum("bj,sjac->sbac", matrices[t], along_u)  # [u piece, j', i', c]
-        weights = sub[..., 9]
+    for t in range(pieces):  # one v piece at a time: [c, u piece, j', i'] = M[t] along j
+        sub = np.matmul(matrices[t], components).reshape(10, pieces, 100)
+        weights = sub[9]
         if not (weights > 0).all():
             raise ValueError("w^3 has a non-positive coefficient on a subpatch: weights must be > 0")
-        h = sub[..., :9].reshape(sub.shape[:3] + (3, 3)) / weights[..., None, None]  # [.., (a, b, c), xyz]
-        norms = np.linalg.norm(h, axis=-1)  # [u piece, j', i', 3]
-        e = quartic_coefficients(h[..., 0, :], h[..., 1, :], h[..., 2, :])
-        size = np.stack([2 * norms[..., 0] * norms[..., 2] + 4 * norms[..., 1] ** 2,
-                         4 * norms[..., 0] * norms[..., 1], 4 * norms[..., 1] * norms[..., 2]], axis=-1)
-        pad = QUARTIC_PAD * size.max(axis=(1, 2))
-        out[t, :, :3] = norms.max(axis=(1, 2))
-        out[t, :, 3] = e[..., 2].max(axis=(1, 2)) + pad[:, 0]
-        out[t, :, 4] = e[..., 1].max(axis=(1, 2)) + pad[:, 1]
-        out[t, :, 5] = -e[..., 1].min(axis=(1, 2)) + pad[:, 1]
-        out[t, :, 6] = e[..., 3].max(axis=(1, 2)) + pad[:, 2]
-        out[t, :, 7] = -e[..., 3].min(axis=(1, 2)) + pad[:, 2]
+        ax, ay, az, bx, by, bz, cx, cy, cz = sub[:9] / weights  # H_k = (a_k, b_k, c_k), [u piece, k]
+        norm_a = np.sqrt(ax * ax + ay * ay + az * az)
+        norm_b = np.sqrt(bx * bx + by * by + bz * bz)
+        norm_c = np.sqrt(cx * cx + cy * cy + cz * cz)
+        # quartic_coefficients' e_22, e_31, e_13
+        e22 = 2 * (ax * cx + ay * cy + az * cz) + 4 * (bx * bx + by * by + bz * bz)
+        e31 = 4 * (ax * bx + ay * by + az * bz)
+        e13 = 4 * (bx * cx + by * cy + bz * cz)
+        pad22 = QUARTIC_PAD * (2 * norm_a * norm_c + 4 * norm_b ** 2).max(axis=1)
+        pad31 = QUARTIC_PAD * (4 * norm_a * norm_b).max(axis=1)
+        pad13 = QUARTIC_PAD * (4 * norm_b * norm_c).max(axis=1)
+        out[t, :, 0], out[t, :, 1], out[t, :, 2] = norm_a.max(axis=1), norm_b.max(axis=1), norm_c.max(axis=1)
+        out[t, :, 3] = e22.max(axis=1) + pad22
+        out[t, :, 4] = e31.max(axis=1) + pad31
+        out[t, :, 5] = -e31.min(axis=1) + pad31
+        out[t, :, 6] = e13.max(axis=1) + pad13
+        out[t, :, 7] = -e13.min(axis=1) + pad13
     return out
 
 
@@ -268,7 +277,6 @@ def majorant_pyramid(majorants: np.ndarray) -> np.ndarray:
     float64 ones.  (S, S, 3) norms alone are widened by norm_forms first."""
     if majorants.shape[-1] == 3:
         majorants = norm_forms(majorants)
-    levels = int(round(math.log2(majorants.shape[0])))
     rows, level = [], majorants
     while True:
         rows.append(level.reshape(-1, TABLE_WIDTH))
