@@ -400,10 +400,18 @@ SCENARIOS = {
 #: Scenarios whose tessellation is then measured on the device (Tessellator.verify,
 #: kernels/stages/verify.cl): both kinds, collapsed edges, culled patches.
 VERIFIED = ("rational_sphere", "pn_icosphere", "mixed_culled")
+#: ... at the barycentric points of this order (10 a triangle; the engine's VERIFY_ORDER 6 has
+#: 28): the same kernel path, and pn_icosphere's uninitialised-value pass takes 26 CPU-seconds
+#: at order 6, 9 without the measurement.
+VERIFY_ORDER = 3
+
+#: many_patches' output (106 kB) in 7 batches of at most 16 kB (at 4 kB: 32 batches, each a full
+#: set of launches; the uninitialised-value pass took 13-40 CPU-seconds a batched scenario)
+MANY_PATCHES_CAP = 16384
 
 #: Scenarios run through Tessellator.tessellate_in_batches (if the pipeline has it) with this
 #: output cap in bytes, so stages 4-5 run on sub-ranges of the patches.
-BATCHED = {"many_patches_batched": ("many_patches", 4096), "esc_levels_strips_batched": ("esc_levels_strips", 8192)}
+BATCHED = {"many_patches_batched": ("many_patches", MANY_PATCHES_CAP), "esc_levels_strips_batched": ("esc_levels_strips", 8192)}
 
 #: Scenarios whose stages 4-5 run by level (Request.emit "by_level", cltess/backends/opencl/levels.py),
 #: whole or (base, output cap in bytes) in batches (the queues and outputs of patch sub-ranges).
@@ -453,13 +461,13 @@ ROWS_IN_PARALLEL = {"many_patches_by_rows": "many_patches", "pn_icosphere_by_row
 POINTS = {"uniform_by_points": "uniform", "pn_icosphere_by_points": "pn_icosphere",
           "collapsed_bottom_direct_by_points": "collapsed_bottom_direct",
           "mixed_culled_by_points": "mixed_culled", "esc_by_points": "esc",
-          "many_patches_batched_by_points": ("many_patches", 4096)}  # batches: first_patch > 0
+          "many_patches_batched_by_points": ("many_patches", MANY_PATCHES_CAP)}  # batches: first_patch > 0
 #: The same with stage 4 from prepared patches (Tessellator(work="point-prep"):
 #: stages/prepared_points.cl prepare_patches and prepared_points; culled patches not prepared,
 #: two kinds, batches; put_point's direct evaluation is POINTS'); also in POINTS (bitwise checks).
 PREPARED_POINTS = {"uniform_by_prepared_points": "uniform", "pn_icosphere_by_prepared_points": "pn_icosphere",
                    "mixed_culled_by_prepared_points": "mixed_culled",
-                   "many_patches_batched_by_prepared_points": ("many_patches", 4096)}
+                   "many_patches_batched_by_prepared_points": ("many_patches", MANY_PATCHES_CAP)}
 #: Stage 4 a work-item per row or ring edge (Tessellator(work="rows-prep"): stages/prepared_points.cl
 #: prepare_patches and prepared_rows, points staged in local memory; stage 5 as "point"): lines
 #: longer than a staged chunk, PN (three edges), culled patches and two kinds, direct evaluation
@@ -467,7 +475,7 @@ PREPARED_POINTS = {"uniform_by_prepared_points": "uniform", "pn_icosphere_by_pre
 PREPARED_ROWS = {"uniform_fine_by_prepared_rows": "uniform_fine", "pn_icosphere_by_prepared_rows": "pn_icosphere",
                  "mixed_culled_by_prepared_rows": "mixed_culled",
                  "collapsed_bottom_direct_by_prepared_rows": "collapsed_bottom_direct",
-                 "many_patches_batched_by_prepared_rows": ("many_patches", 4096)}
+                 "many_patches_batched_by_prepared_rows": ("many_patches", MANY_PATCHES_CAP)}
 POINTS.update(PREPARED_POINTS)
 POINTS.update(PREPARED_ROWS)
 #: Session frames (cltess.Session) whose second frame does not fit the first one's buffers:
@@ -654,7 +662,7 @@ def run_scenario(name: str, tessellator, out_dir: Path) -> dict:
         plan = tessellator.plan(scene, **options)
         tess = tessellator.emit(plan, 0, plan.num_patches)
         if name in VERIFIED:
-            verified = tessellator.verify(scene, plan, tess)
+            verified = tessellator.verify(scene, plan, tess, order=VERIFY_ORDER)
     write_npz(tess, out_dir / f"{name}.npz")
     result = {"name": name, "stats": {k: v for k, v in tess.stats.items() if isinstance(v, int)},
               "factors": tess.factors.tolist()}

@@ -241,7 +241,8 @@ def test_results_match_pocl(oclgrind, tmp_path_factory, tessellator, pass_name):
                     assert run.results[fused]["stats"][stat] == run.results[name]["stats"][stat], f"{fused}: {stat}"
         if name in scenarios.VERIFIED:
             plan = tessellator.plan(scene, **options)
-            ours = tessellator.verify(scene, plan, tessellator.emit(plan, 0, plan.num_patches))
+            ours = tessellator.verify(scene, plan, tessellator.emit(plan, 0, plan.num_patches),
+                                      order=scenarios.VERIFY_ORDER)
             assert abs(run.results[name]["verify_ratio"] - ours["verify_ratio"]) <= 1e-5, name
 
 
