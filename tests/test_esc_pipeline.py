@@ -289,7 +289,7 @@ def test_max_level_1_to_3_closed_and_monotone(tessellator, rng):
     for max_level in (1, 2, 3, None):
         options = {} if max_level is None else {"max_level": max_level}
         previous = None
-        for eps in sorted(10.0 ** rng.uniform(-3.5, -0.5, 4), reverse=True):
+        for eps in sorted(10.0 ** rng.uniform(-3.5, -0.5, 3), reverse=True):
             request = Request.of(eps=float(eps), pattern="esc", **options)
             device, host = tessellator.tessellate(scene, request), NumpyBackend().tessellate(scene, request)
             assert np.array_equal(device.factors, host.factors)

@@ -38,7 +38,7 @@ def check_pattern(f, fold_tolerance=1e-9):
 
 
 def test_whole_factor_triples_exhaustive():
-    for f in itertools.product(range(1, 14), repeat=3):
+    for f in itertools.product(range(1, 12), repeat=3):  # 1,331 triples: odd and even plateaus up to 11
         check_pattern([x * FIXED_ONE for x in f])
 
 
@@ -52,7 +52,7 @@ def test_closed_forms():
             assert sd2_counts([fa, fa, fa])[:2] == ((na + 1) * (na + 2) // 2, na * na)
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=150, deadline=None)
 @given(st.lists(st.floats(1.0, 64.0), min_size=3, max_size=3), st.integers(0, 3))
 def test_random_fractional_factors(reals, ties):
     f = list(to_fixed(reals))
