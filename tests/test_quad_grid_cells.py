@@ -7,13 +7,9 @@ takes the inner-cell loop.  tests/contracts/test_patterns.py checks the same wit
 edges; tests/test_triangle_at.py checks small uniform grids under every collapsed mask against
 ``pattern_triangle_at``."""
 import numpy as np
-import pyopencl.array as cl_array
 
 from cltess.patterns import PATTERNS
-
-
-def offsets(counts):
-    return np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+from support.factors import device_counts_and_indices, offsets
 
 
 def random_collapsed_factors(rng, count, high=40):
@@ -33,17 +29,7 @@ def test_collapsed_grids_equal_the_mirror(tessellator, rng):
     pattern = PATTERNS["quad_transition"]
     factors, uniform = random_collapsed_factors(rng, 800)
     assert uniform.sum() > 300 and (factors < 0).any(axis=1)[uniform].sum() > 100
-    count = len(factors)
-    device_factors = cl_array.to_device(tessellator.queue, factors)
-    vertex_offsets, index_offsets, _ = tessellator.stage_counts(device_factors, [(pattern, 0, count)])
-    layouts = [pattern.layout(f) for f in factors]
-    vertex_counts = [len(uv) for uv, _ in layouts]
-    assert np.array_equal(vertex_offsets.get(), offsets(vertex_counts))
-    assert np.array_equal(index_offsets.get(), offsets([3 * len(t) for _, t in layouts]))
-    total = int(index_offsets[count].get())
-    triangles, _ = tessellator.stage_indices(device_factors, vertex_offsets, index_offsets, (0, total), (0, count),
-                                             kind=pattern, work="patch")
-    got = triangles.get().reshape(-1, 3)
-    firsts, index_firsts = offsets(vertex_counts), offsets([len(t) for _, t in layouts])
+    layouts, firsts, got = device_counts_and_indices(tessellator, pattern, factors, work="patch")
+    index_firsts = offsets([len(t) for _, t in layouts])
     for p, (_, expected) in enumerate(layouts):  # patch by patch, so that a failure names its factors
         assert np.array_equal(got[index_firsts[p]:index_firsts[p + 1]], expected + firsts[p]), factors[p]

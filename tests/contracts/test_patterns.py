@@ -7,14 +7,10 @@ import pytest
 
 from cltess.criteria import ObjectSpace
 from cltess.patterns import PATTERNS
-from support.factors import random_pattern_factors
+from support.factors import device_counts_and_indices, random_pattern_factors
 from support.kinds import kind_for, random_source
 
 PATTERN_LIST = list(PATTERNS.values())
-
-
-def offsets(counts):
-    return np.concatenate([[0], np.cumsum(counts)])
 
 
 @pytest.fixture(params=PATTERN_LIST, ids=[p.name for p in PATTERN_LIST])
@@ -24,18 +20,9 @@ def pattern(request):
 
 def test_counts_and_triangles_equal_the_mirror(tessellator, rng, pattern):
     factors = random_pattern_factors(rng, pattern, 600)
-    count = len(factors)
-    device_factors = cl_array.to_device(tessellator.queue, factors)
-    vertex_offsets, index_offsets, _ = tessellator.stage_counts(device_factors, [(pattern, 0, count)])
-    layouts = [pattern.layout(f) for f in factors]
-    vertex_counts = [len(uv) for uv, _ in layouts]
-    assert np.array_equal(vertex_offsets.get(), offsets(vertex_counts))
-    assert np.array_equal(index_offsets.get(), offsets([3 * len(t) for _, t in layouts]))
-    total = int(index_offsets[count].get())
-    triangles, _ = tessellator.stage_indices(device_factors, vertex_offsets, index_offsets, (0, total), (0, count),
-                                             kind=pattern)
-    expected = np.concatenate([t + first for (_, t), first in zip(layouts, offsets(vertex_counts))])
-    assert np.array_equal(triangles.get(), expected)
+    layouts, firsts, triangles = device_counts_and_indices(tessellator, pattern, factors)
+    expected = np.concatenate([np.reshape(t, (-1, 3)) + first for (_, t), first in zip(layouts, firsts)])
+    assert np.array_equal(triangles, expected)
 
 
 @pytest.mark.parametrize("fd", [True, False], ids=["fd", "direct"])

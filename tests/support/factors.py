@@ -92,3 +92,27 @@ def random_pattern_factors(rng, pattern, count, high=40):
         return random_esc_records(rng, count)
     factors = {"quad": random_factors, "tri": random_triangle_factors}[pattern.domain](rng, count, high)
     return dyadic_factors(factors, max_level=30) if pattern.dyadic else factors
+
+
+def offsets(counts) -> np.ndarray:
+    """Stage 3's offsets of these counts: 0, then their running sums (the last one the total)."""
+    return np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+
+
+def device_counts_and_indices(tessellator, pattern, factors, work=None):
+    """Stages 3 and 5 of ``pattern`` on the device for ``factors``, their offsets checked equal
+    to the mirror's layouts (``pattern.layout``).  Returns (layouts, each patch's first vertex,
+    the (T, 3) triangles of the whole batch, global vertex numbers)."""
+    import pyopencl.array as cl_array
+
+    count = len(factors)
+    device_factors = cl_array.to_device(tessellator.queue, factors)
+    vertex_offsets, index_offsets, _ = tessellator.stage_counts(device_factors, [(pattern, 0, count)])
+    layouts = [pattern.layout(f) for f in factors]
+    firsts = offsets([len(uv) for uv, _ in layouts])
+    assert np.array_equal(vertex_offsets.get(), firsts)
+    assert np.array_equal(index_offsets.get(), offsets([3 * len(t) for _, t in layouts]))
+    total = int(index_offsets[count].get())
+    triangles, _ = tessellator.stage_indices(device_factors, vertex_offsets, index_offsets, (0, total), (0, count),
+                                             kind=pattern, work=work)
+    return layouts, firsts, triangles.get().reshape(-1, 3)
