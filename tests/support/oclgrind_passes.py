@@ -32,7 +32,7 @@ PASSES = {
                           selftests={"selftest_oob_write": "Invalid write of size 4",
                                      "selftest_uninitialized": "Uninitialized value written to global memory"}),
 }
-TIMEOUT_S = 1800  # per pass, from its start; ~10 s and ~90 s alone on 2 idle vCPUs, far more under load
+TIMEOUT_S = 1800  # per pass, from its start; ~80 and ~440 CPU-seconds (2026-11-27), far more wall under load
 
 
 @dataclass
