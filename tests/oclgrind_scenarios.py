@@ -402,7 +402,7 @@ SCENARIOS = {
 VERIFIED = ("rational_sphere", "pn_icosphere", "mixed_culled")
 #: ... at the barycentric points of this order (10 a triangle; the engine's VERIFY_ORDER 6 has
 #: 28): the same kernel path, and pn_icosphere's uninitialised-value pass takes 26 CPU-seconds
-#: at order 6, 9 without the measurement.
+#: at order 6, 9 at order 1 (the corners only).
 VERIFY_ORDER = 3
 
 #: many_patches' output (106 kB) in 7 batches of at most 16 kB (at 4 kB: 32 batches, each a full
