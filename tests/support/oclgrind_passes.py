@@ -1,20 +1,23 @@
 """The two Oclgrind passes of tests/test_oclgrind.py, run as subprocesses of
 tests/oclgrind_scenarios.py, and started early.
 
-The simulator is single-threaded and slow (the uninitialised-value pass takes minutes on 2 cores)
-while the rest of the suite keeps about one core busy.  So ``conftest.py`` starts both full passes
-in the background as soon as the tests are collected (``start_background``) and runs
-test_oclgrind.py's tests last; ``finish`` then waits for a pass and reads it.  A run of
-test_oclgrind.py alone starts them the same way, at its collection.
+The simulator is single-threaded and slow (the uninitialised-value pass takes minutes on 2 cores).
+So ``conftest.py`` starts both full passes in the background as soon as the tests are collected
+(``start_background``), once per run: by pytest-xdist's controller when the tests run in workers,
+which then find the passes' folder in their ``workerinput`` (``attach``).  test_oclgrind.py's
+tests run last; ``finish`` waits for a pass and reads it.  A pass's wrapper writes its exit code
+to a file when it ends, so a process that did not start it can wait for it too.
 """
 from __future__ import annotations
 
 import json
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -49,10 +52,12 @@ class Run:
 
 @dataclass
 class Started:
-    """A pass under way: its process, whose stdout and stderr go to files in ``out_dir``."""
+    """A pass under way, writing into ``out_dir``: stdout.txt, stderr.txt, and ``returncode``
+    when it ends (a pass past TIMEOUT_S is killed, and its scenarios read as not finished).
+    ``process`` is the wrapper, in the process that started it (None in another)."""
 
-    process: subprocess.Popen
     out_dir: Path
+    process: subprocess.Popen | None = None
 
 
 def pass_names(name: str) -> list[str]:
@@ -67,21 +72,34 @@ def start(name: str, out_dir: Path, names: list[str] | None = None) -> Started:
     env = {k: v for k, v in os.environ.items() if not k.startswith(("OCLGRIND_", "PYOPENCL_BUILD"))}
     env.update(spec["env"], CLTESS_DEVICE="oclgrind", OCLGRIND_MAX_ERRORS="1000000")
     out_dir.mkdir(parents=True, exist_ok=True)
+    runner = [sys.executable, str(RUNNER), *spec["args"], "--out", str(out_dir), *(names or pass_names(name))]
     with open(out_dir / "stdout.txt", "wb") as stdout, open(out_dir / "stderr.txt", "wb") as stderr:
-        process = subprocess.Popen(
-            [sys.executable, str(RUNNER), *spec["args"], "--out", str(out_dir), *(names or pass_names(name))],
-            stdout=stdout, stderr=stderr, env=env)
-    return Started(process, out_dir)
+        process = subprocess.Popen([sys.executable, "-c", WRAPPER, str(TIMEOUT_S), *runner], cwd=out_dir,
+                                   stdout=stdout, stderr=stderr, env=env, start_new_session=True)
+    return Started(out_dir, process)
+
+
+# A pass runs under this wrapper: it kills the runner past TIMEOUT_S and then writes the exit
+# code (-9 when killed) into ``returncode``, renamed into place so that no waiter reads half of it.
+WRAPPER = """
+import os, subprocess, sys
+try:
+    code = subprocess.run(sys.argv[2:], timeout=float(sys.argv[1])).returncode
+except subprocess.TimeoutExpired:
+    code = -9
+with open("returncode.part", "w") as part:
+    part.write(str(code))
+os.replace("returncode.part", "returncode")
+"""
 
 
 def finish(started: Started) -> Run:
-    """Wait for a pass and read what it wrote (a pass past TIMEOUT_S is killed: its scenarios
-    then read as not finished)."""
-    try:
-        started.process.wait(timeout=TIMEOUT_S)
-    except subprocess.TimeoutExpired:
-        started.process.kill()
+    """Wait for a pass to end and read what it wrote."""
+    if started.process is not None:
         started.process.wait()
+    returncode_file = started.out_dir / "returncode"
+    while not returncode_file.exists():  # a pass that another process started
+        time.sleep(1)
     stdout = (started.out_dir / "stdout.txt").read_text(errors="replace")
     stderr = (started.out_dir / "stderr.txt").read_text(errors="replace")
     results = {}
@@ -89,29 +107,56 @@ def finish(started: Started) -> Run:
         record = json.loads(line)
         if "name" in record:
             results[record["name"]] = record
-    return Run(started.process.returncode, results, scenarios.parse_stderr(stderr), stderr, started.out_dir)
+    returncode = int(returncode_file.read_text())
+    return Run(returncode, results, scenarios.parse_stderr(stderr), stderr, started.out_dir)
 
 
-# The full passes started in the background by conftest.py, and where they write.
+# The full passes started in the background by this process (conftest.py, or pytest-xdist's
+# controller), or by the controller for this worker (``attach``), and where they write.
 _BACKGROUND: dict[str, Started] = {}
 _FINISHED: dict[str, Run] = {}
 _FOLDER: list[Path] = []
+_ATTACHED: list[Path] = []
+
+
+def wanted(nodeids: list[str]) -> bool:
+    """Whether a run of these tests wants the full passes: any test of test_oclgrind.py but
+    the one that runs its own pass, and an Oclgrind platform to run them on."""
+    simulated = [nodeid.split("::")[-1] for nodeid in nodeids if nodeid.split("::")[0].endswith("test_oclgrind.py")]
+    if all(test.startswith("test_out_of_bounds_write_alone_fails_the_check") for test in simulated):
+        return False
+    from cltess.device import list_devices
+    return any(info.matches("oclgrind") for info in list_devices())
+
+
+def background_folder() -> Path:
+    """The folder the background passes write into (made once per process that starts them)."""
+    if not _FOLDER:
+        _FOLDER.append(Path(tempfile.mkdtemp(prefix="cltess-oclgrind-")))
+    return _FOLDER[0]
 
 
 def start_background() -> None:
     """Start both full passes now (once per test session)."""
     if _BACKGROUND:
         return
-    _FOLDER.append(Path(tempfile.mkdtemp(prefix="cltess-oclgrind-")))
     for name in PASSES:
-        _BACKGROUND[name] = start(name, _FOLDER[0] / name)
+        _BACKGROUND[name] = start(name, background_folder() / name)
+
+
+def attach(folder: Path) -> None:
+    """In a pytest-xdist worker: the passes, if the controller started them, write into ``folder``."""
+    _ATTACHED.append(folder)
 
 
 def full_pass(name: str, out_dir: Path) -> Run:
-    """The full pass ``name``: the background one if started, else run now into ``out_dir``."""
+    """The full pass ``name``: the background one if started (here, or by the controller), else
+    run now into ``out_dir``."""
     if name not in _FINISHED:
-        started = _BACKGROUND.get(name) or start(name, out_dir)
-        _FINISHED[name] = finish(started)
+        started = _BACKGROUND.get(name)
+        if started is None and _ATTACHED and (_ATTACHED[0] / name).is_dir():
+            started = Started(_ATTACHED[0] / name)
+        _FINISHED[name] = finish(started or start(name, out_dir))
     return _FINISHED[name]
 
 
@@ -119,7 +164,7 @@ def stop_background() -> None:
     """End of the test session: stop what still runs (a run stopped early) and remove the files."""
     for started in _BACKGROUND.values():
         if started.process.poll() is None:
-            started.process.kill()
+            os.killpg(started.process.pid, signal.SIGKILL)
             started.process.wait()
     for folder in _FOLDER:
         shutil.rmtree(folder, ignore_errors=True)
