@@ -208,9 +208,12 @@ def three_patch_edge():
 
 
 def many_patches():
-    """9x8 = 72 patches, more than one work-group of 64: the index guards of every kernel."""
+    """9x8 = 72 patches, more than one work-group of 64: the index guards of every kernel.  Edge
+    factors 1 to 3, 40 patches with uneven ones, none saturated: 834 vertices (at eps 0.05 and
+    factors up to 6, 1,912: the uninitialised-value pass took about twice as long on the 10
+    scenarios built on this one; the per-vertex kernels simulate a work-item a vertex)."""
     rng = np.random.default_rng(5)
-    return height_grid(bumps(9, 8, rng.uniform(0.0, 0.3, (8, 9)))), dict(eps=0.05, max_factor=6)
+    return height_grid(bumps(9, 8, rng.uniform(0.0, 0.3, (8, 9)))), dict(eps=0.2, max_factor=3)
 
 
 def icosphere_mesh(object_id: int = 0):
