@@ -3,6 +3,8 @@ section 3), with the rational second-derivative bounds of docs/rational-bound.md
 of kernels/criteria/zs.h."""
 from __future__ import annotations
 
+import functools
+import itertools
 import math
 
 import numpy as np
@@ -160,7 +162,14 @@ CUBIC_DERIVATIVE = np.array([[-3.0, 3, 0, 0], [-1, -1, 2, 0], [0, -2, 1, 1], [0,
 
 def _binomials(shape) -> np.ndarray:
     """C(n_v, j) C(n_u, i) for a net of the given (n_v + 1, n_u + 1) shape."""
-    return np.outer(*[[math.comb(n - 1, k) for k in range(n)] for n in shape[:2]])
+    return _binomial_table(*shape[:2])
+
+
+@functools.lru_cache(maxsize=None)
+def _binomial_table(rows: int, columns: int) -> np.ndarray:
+    table = np.outer(*[[math.comb(n - 1, k) for k in range(n)] for n in (rows, columns)])
+    table.flags.writeable = False  # shared by every caller
+    return table
 
 
 def _bernstein_product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -171,7 +180,7 @@ def _bernstein_product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     b_scaled = b * _binomials(b.shape)[..., None]
     shape = (a.shape[0] + b.shape[0] - 1, a.shape[1] + b.shape[1] - 1)
     out = np.zeros(shape + np.broadcast_shapes(a.shape[2:], b.shape[2:]))
-    for j, i in np.ndindex(*a.shape[:2]):
+    for j, i in itertools.product(range(a.shape[0]), range(a.shape[1])):
         out[j:j + b.shape[0], i:i + b.shape[1]] += a_scaled[j, i] * b_scaled
     return out / _binomials(shape)[..., None]
 

@@ -84,8 +84,10 @@ def limit_normal(patch, u, v, b, b_u, b_v) -> np.ndarray:
 
 def surface_points(patches: np.ndarray, patch_ids: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Positions (N, 3) of many patches at once: sample n is patch ``patch_ids[n]`` at (u[n], v[n])."""
-    b = np.einsum("nj,ni,njic->nc", bernstein3(np.asarray(v, float)), bernstein3(np.asarray(u, float)),
-                  patches[patch_ids])
+    # The tensor-product weights B_j(v) B_i(u) first, then one product per sample: the same sums
+    # in the same order as einsum("nj,ni,njic->nc"), which loops over all three at once, 2x slower.
+    weights = (bernstein3(np.asarray(v, float))[:, :, None] * bernstein3(np.asarray(u, float))[:, None, :])
+    b = np.einsum("nk,nkc->nc", weights.reshape(-1, 16), patches.reshape(len(patches), 16, 4)[patch_ids])
     return b[:, :3] / b[:, 3:]
 
 
