@@ -64,39 +64,3 @@ def test_no_random_access_without_uniform_factors(tessellator):
     _, counts, _, offered = run_both(tessellator, factors, np.zeros(3, np.int32), width=64)
     assert not offered.any() and (counts > 0).all()
 
-
-STEP_KERNEL = """
-__kernel void stepped(__global const int4 *factors, __global const int *masks, __global const uint *counts,
-                      int width, __global uint *out)
-{
-    int id = get_global_id(0);
-    triangle_cursor cursor;
-    if (!counts[id] || !pattern_triangle_seek(factors[id], masks[id], 0, &cursor))
-        return;
-    for (uint t = 0; t < counts[id]; ++t) {
-        if (t)
-            pattern_triangle_next(&cursor);
-        vstore3(pattern_cursor_triangle(&cursor), width * id + t, out);
-    }
-}
-"""
-
-
-def test_stepping_the_cursor_is_the_emission(tessellator):
-    """pattern_triangle_next from triangle 0 (stage 5's runs) gives grid_cells' triangles in order."""
-    cases = [(a, b, mask) for a, b in itertools.product(range(1, 8), repeat=2) for mask in range(16)]
-    factors = np.array([(a, b, a, b) for a, b, _ in cases], np.int32)
-    masks = np.array([mask for *_, mask in cases], np.int32)
-    width = 2 * 7 * 7
-    emitted, counts, _, _ = run_both(tessellator, factors, masks, width)
-    ctx, queue = tessellator.context, tessellator.queue
-    program = cl.Program(ctx, '#include "common.h"\n#include "patterns/quad_transition.h"\n' + STEP_KERNEL).build(
-        options=["-I", str(kernel_dir())] + correctly_rounded_division(ctx.devices[0]))
-    mf = cl.mem_flags
-    stepped = np.full((len(cases), width, 3), 0xFFFFFFFF, np.uint32)
-    buffers = [cl.Buffer(ctx, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=a) for a in (factors, masks, counts)]
-    out = cl.Buffer(ctx, mf.READ_WRITE | mf.COPY_HOST_PTR, hostbuf=stepped)
-    program.stepped(queue, (len(cases),), None, *buffers, np.int32(width), out)
-    cl.enqueue_copy(queue, stepped, out)
-    for case, n, emit, step in zip(cases, counts, emitted, stepped):
-        assert np.array_equal(step[:n], emit[:n]), case

@@ -159,38 +159,18 @@ inline void grid_cells(__global uint *out, uint *count, uint base, pattern_grid 
     }
 }
 
-/* Random access to the triangles of a patch whose triangles are the plain A x B grid (uniform
- * factors), in the order grid_cells emits them: cells row by row, each (a, b, c) then (a, c, d),
- * less those grid_cells leaves out on collapsed edges.  In row j the triangle slots are
- * s = 2 i + h (h = 0: (a, b, c), 1: (a, c, d)); a collapsed edge 0 removes every h = 0 slot of
- * row 0, edge 2 every h = 1 slot of row B - 1, edge 1 slot 2 (A - 1) of every row and edge 3
- * slot 1 (grid_slot_kept, grid_cell's rule).  A cursor is a patch's grid and a kept slot:
- * pattern_triangle_seek puts it on triangle t (the k-th kept slot of a row found by stepping
- * over the removed ones), pattern_triangle_next on the next triangle (the next kept slot, without
- * a division: stage 5 walks a run of consecutive triangles so), pattern_cursor_triangle gives
- * its local vertex numbers (by uniform_grid_index: no "% ring", the same numbers as grid_cell's).
- * Stage 5 a work-item per triangle (stages/triangles.cl) uses them; tests/test_triangle_at.py
- * checks them against grid_cells for every collapsed mask. */
+/* Triangle t of a patch whose triangles are the plain A x B grid (uniform factors): *triangle
+ * its local vertex numbers, as grid_cells emits them (cells row by row, each (a, b, c) then
+ * (a, c, d), less those grid_cells leaves out on collapsed edges).  In row j the triangle slots
+ * are s = 2 i + h (h = 0: (a, b, c), 1: (a, c, d)); a collapsed edge 0 removes every h = 0 slot
+ * of row 0, edge 2 every h = 1 slot of row B - 1, edge 1 slot 2 (A - 1) of every row and edge 3
+ * slot 1; the k-th kept slot is found by stepping over the removed ones.  Returns 0 for any
+ * other patch, whose triangles only pattern_primitives makes.  The corners' numbers by
+ * uniform_grid_index (no "% ring"; the same numbers as grid_cell's).  Stage 5 a work-item per triangle
+ * (stages/triangles.cl) uses it; tests/test_triangle_at.py checks it against grid_cells for
+ * every collapsed mask. */
 #define PATTERN_TRIANGLE_AT 1
-
-typedef struct {
-    pattern_grid g;
-    int collapsed;
-    int j;      /* row */
-    uint s;     /* slot 2 i + h in the row */
-} triangle_cursor;
-
-inline int grid_slot_kept(pattern_grid g, int collapsed, int j, uint s)
-{
-    int i = (int)(s >> 1);
-    if (s & 1)
-        return !((j + 1 == g.core.y && (collapsed & 4)) || (i == 0 && (collapsed & 8)));
-    return !((j == 0 && (collapsed & 1)) || (i + 1 == g.core.x && (collapsed & 2)));
-}
-
-/* The cursor on triangle t; 0 for a patch without uniform factors (only pattern_primitives makes
- * its triangles). */
-inline int pattern_triangle_seek(int4 f, int collapsed, uint t, __private triangle_cursor *cursor)
+inline int pattern_triangle_at(int4 f, int collapsed, uint t, __private uint3 *triangle)
 {
     pattern_grid g = quad_grid(f);
     if (!g.uniform)
@@ -220,42 +200,11 @@ inline int pattern_triangle_seek(int4 f, int collapsed, uint t, __private triang
         s = k + (c3 && k >= 1);
         s += c1 && s >= 2 * (uint)a_steps - 2;
     }
-    cursor->g = g;
-    cursor->collapsed = collapsed;
-    cursor->j = j;
-    cursor->s = s;
-    return 1;
-}
-
-/* The cursor on the next triangle of its patch (which must have one). */
-inline void pattern_triangle_next(__private triangle_cursor *cursor)
-{
-    uint slots = 2 * (uint)cursor->g.core.x;
-    do {
-        if (++cursor->s == slots) {
-            cursor->s = 0;
-            ++cursor->j;
-        }
-    } while (!grid_slot_kept(cursor->g, cursor->collapsed, cursor->j, cursor->s));
-}
-
-inline uint3 pattern_cursor_triangle(__private const triangle_cursor *cursor)
-{
-    pattern_grid g = cursor->g;
-    int i = (int)(cursor->s >> 1), j = cursor->j;
+    int i = (int)(s >> 1);
     uint a = uniform_grid_index(g, (int2)(i, j)), c = uniform_grid_index(g, (int2)(i + 1, j + 1));
-    uint b = (cursor->s & 1) ? c : uniform_grid_index(g, (int2)(i + 1, j));
-    uint d = (cursor->s & 1) ? uniform_grid_index(g, (int2)(i, j + 1)) : c;
-    return (uint3)(a, b, d);
-}
-
-/* Triangle t of a uniform patch: *triangle its local vertex numbers; 0 for any other patch. */
-inline int pattern_triangle_at(int4 f, int collapsed, uint t, __private uint3 *triangle)
-{
-    triangle_cursor cursor;
-    if (!pattern_triangle_seek(f, collapsed, t, &cursor))
-        return 0;
-    *triangle = pattern_cursor_triangle(&cursor);
+    uint b = (s & 1) ? c : uniform_grid_index(g, (int2)(i + 1, j));
+    uint d = (s & 1) ? uniform_grid_index(g, (int2)(i, j + 1)) : c;
+    *triangle = (uint3)(a, b, d);
     return 1;
 }
 

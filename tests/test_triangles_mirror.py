@@ -1,9 +1,10 @@
-"""Stage 5 a work-item per triangle, in runs with staged stores (stages/triangles.cl, issue 15): on random
-quad factors (uniform grids, transitions, collapsed edges, culled patches) the kernel's indices are
-the NumPy mirror's (cltess.patterns.quad_transition.quad_pattern, each patch's triangles offset by
-its first vertex), in batches (first_patch > 0) and at several triangles per work-item (runs of 1, 3 and 16; 40 is
-three steps, the last one partial), so that runs and steps end inside a patch, past the batch's end
-and on the whole-patch emissions; and the kernel's work-group size is the host's."""
+"""Stage 5 a work-item per triangle (stages/triangles.cl, issue 15) against the NumPy mirror: on
+random quad factors (uniform grids, transitions, collapsed edges, culled patches) the kernel's
+indices are cltess.patterns.quad_transition.quad_pattern's, each patch's triangles offset by its
+first vertex; for the whole scene and a batch inside it (first_patch > 0), at 1, 3, 16 and 40
+triangles per work-item (a work-item's triangles cross patches, and the batch's end falls inside
+a work-group).  Random access (pattern_triangle_at) makes the uniform grids' triangles,
+pattern_primitives the others'."""
 import numpy as np
 import pyopencl as cl
 import pyopencl.array as cl_array
@@ -35,17 +36,8 @@ def mirror(factors: np.ndarray):
     return vertex_offsets, index_offsets, np.concatenate(triangles).astype(np.uint32)
 
 
-def test_triangle_group_is_the_hosts(tessellator):
-    constants = np.zeros(2, np.uint32)  # TRIANGLE_GROUP, TRIANGLE_RUN
-    buffer = cl.Buffer(tessellator.context, cl.mem_flags.READ_WRITE, constants.nbytes)
-    tessellator.programs.kernel("triangles", "triangle_constants", pattern=BEZIER.pattern)(
-        tessellator.queue, (1,), None, buffer)
-    cl.enqueue_copy(tessellator.queue, constants, buffer)
-    assert constants[0] == opencl.WORK_GROUP and constants[1] >= 1
-
-
 @pytest.mark.parametrize("per_item", [1, 3, 16, 40])
-def test_staged_triangles_are_the_mirrors(tessellator, rng, per_item):
+def test_triangles_are_the_mirrors(tessellator, rng, per_item):
     by_points = opencl.Tessellator(tessellator.device, work="point")
     by_points.records_per_item = per_item
     factors = random_quad_factors(rng, 600)
