@@ -63,4 +63,3 @@ def test_no_random_access_without_uniform_factors(tessellator):
     factors = np.array([(3, 2, 4, 2), (3, 2, 3, 5), (2, 2, 2, 3)], np.int32)
     _, counts, _, offered = run_both(tessellator, factors, np.zeros(3, np.int32), width=64)
     assert not offered.any() and (counts > 0).all()
-
