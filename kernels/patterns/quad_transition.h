@@ -166,7 +166,9 @@ inline void grid_cells(__global uint *out, uint *count, uint base, pattern_grid 
  * of row 0, edge 2 every h = 1 slot of row B - 1, edge 1 slot 2 (A - 1) of every row and edge 3
  * slot 1; the k-th kept slot is found by stepping over the removed ones.  Returns 0 for any
  * other patch, whose triangles only pattern_primitives makes.  The corners' numbers by
- * uniform_grid_index (no "% ring"; the same numbers as grid_cell's).  Stage 5 a work-item per triangle
+ * uniform_grid_index (no "% ring"; the same numbers as grid_cell's): stage 5 of uniform level 16
+ * on the H100 took 0.146 ms against 0.216 by pattern_grid_index (bench/RESULTS.md, "Issue 15:
+ * stage 5's triangle math (session 8, branch gpu15f)").  Stage 5 a work-item per triangle
  * (stages/triangles.cl) uses it; tests/test_triangle_at.py checks it against grid_cells for
  * every collapsed mask. */
 #define PATTERN_TRIANGLE_AT 1
