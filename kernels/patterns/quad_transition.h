@@ -165,7 +165,10 @@ inline void grid_cells(__global uint *out, uint *count, uint base, pattern_grid 
  * are s = 2 i + h (h = 0: (a, b, c), 1: (a, c, d)); a collapsed edge 0 removes every h = 0 slot
  * of row 0, edge 2 every h = 1 slot of row B - 1, edge 1 slot 2 (A - 1) of every row and edge 3
  * slot 1; the k-th kept slot is found by stepping over the removed ones.  Returns 0 for any
- * other patch, whose triangles only pattern_primitives makes.  Stage 5 a work-item per triangle
+ * other patch, whose triangles only pattern_primitives makes.  The corners' numbers by
+ * uniform_grid_index (no "% ring"; the same numbers as grid_cell's): stage 5 of uniform level 16
+ * on the H100 took 0.146 ms against 0.216 by pattern_grid_index (bench/RESULTS.md, "Issue 15:
+ * stage 5's triangle math (session 8, branch gpu15f)").  Stage 5 a work-item per triangle
  * (stages/triangles.cl) uses it; tests/test_triangle_at.py checks it against grid_cells for
  * every collapsed mask. */
 #define PATTERN_TRIANGLE_AT 1
@@ -200,9 +203,9 @@ inline int pattern_triangle_at(int4 f, int collapsed, uint t, __private uint3 *t
         s += c1 && s >= 2 * (uint)a_steps - 2;
     }
     int i = (int)(s >> 1);
-    uint a = pattern_grid_index(g, (int2)(i, j)), c = pattern_grid_index(g, (int2)(i + 1, j + 1));
-    uint b = (s & 1) ? c : pattern_grid_index(g, (int2)(i + 1, j));
-    uint d = (s & 1) ? pattern_grid_index(g, (int2)(i, j + 1)) : c;
+    uint a = uniform_grid_index(g, (int2)(i, j)), c = uniform_grid_index(g, (int2)(i + 1, j + 1));
+    uint b = (s & 1) ? c : uniform_grid_index(g, (int2)(i + 1, j));
+    uint d = (s & 1) ? uniform_grid_index(g, (int2)(i, j + 1)) : c;
     *triangle = (uint3)(a, b, d);
     return 1;
 }

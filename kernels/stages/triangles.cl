@@ -1,15 +1,19 @@
 /* Stage 5 a work-item per output triangle (issue 15, for GPUs): consecutive work-items write
  * consecutive triangles (coalesced stores).  As stages/vertex_points.cl: a work-group of G
  * work-items owns G * per_item consecutive triangles of the batch, in step k its work-item l
- * writes triangle k G + l of them, and it finds a triangle's patch by patch_of (common.h) over
- * index_offsets only when the patch changes (64-bit divisions by 3 only then).  A pattern with
+ * writes triangle k G + l of them, and it finds a triangle's patch over index_offsets only when
+ * the patch changes (64-bit divisions by 3 only then): its first by patch_of (common.h), the next
+ * ones by patch_after, galloping from the patch it leaves.  A pattern with
  * random access to a regular patch's triangles (PATTERN_TRIANGLE_AT, pattern_triangle_at) gives
  * triangle t directly; any other patch is emitted whole by the work-item of its triangle 0 with
  * pattern_primitives, as stages/indices.cl does.  Either way the bits of stages/indices.cl.
  * That work-item holds its warp while it walks the patch: on the H100, uniform level 16 on 32,000
  * teapot patches took 0.64 ms here while the quad grids with a collapsed edge (the teapot's lid
  * and bottom) were walked, 0.25 ms since pattern_triangle_at covers them (bench/RESULTS.md,
- * "Stage 5 by triangle").
+ * "Stage 5 by triangle"), 0.136 ms with its corners by uniform_grid_index and patch_after.
+ * Staging a step's triangles in local memory and writing them as consecutive words (whole
+ * sectors) was slower there: 0.184 ms, 0.205 with a run of 16 consecutive triangles per
+ * work-item (bench/RESULTS.md, "Issue 15: stage 5's triangle math").
  * The batch is patches first_patch .. first_patch + num_patches - 1; work-items past its last
  * triangle stop. */
 __kernel void triangles(__global const int4 *factors, __global const ulong *vertex_offsets,
@@ -27,7 +31,7 @@ __kernel void triangles(__global const int4 *factors, __global const ulong *vert
     int collapsed = 0;
     for (uint k = 0; k < per_item && at < end; ++k, at += group) {
         if (at >= patch_end) {
-            p = patch_of(index_offsets, p, last, 3 * at);
+            p = patch_end ? patch_after(index_offsets, p, last, 3 * at) : patch_of(index_offsets, p, last, 3 * at);
             patch_start = index_offsets[p] / 3;
             patch_end = index_offsets[p + 1] / 3;
             f = patch_factors(factors[p], &collapsed);
