@@ -151,5 +151,11 @@ def _round(mantissa: np.ndarray, power: np.ndarray):
     scaled = exact / scale
     up = power > 0
     scaled[up] = exact[up] * scale[up]
-    significand = scaled.view(np.uint64)[0::2]  # x87: the low 8 of 16 bytes
-    return scaled.astype(np.float64), (significand & np.uint64(MIDPOINT_MASK)) == MIDPOINT_BITS
+    return scaled.astype(np.float64), float64_midpoints(scaled)
+
+
+def float64_midpoints(values: np.ndarray) -> np.ndarray:
+    """Which extended (long double) values lie exactly halfway between two float64 (normal
+    range): the low 11 of their 64 significand bits are 10000000000."""
+    significand = values.view(np.uint64)[0::2]  # x87: the low 8 of 16 bytes
+    return (significand & np.uint64(MIDPOINT_MASK)) == MIDPOINT_BITS
