@@ -184,8 +184,8 @@ def _signed_volumes(points: np.ndarray, grid: np.ndarray, component: np.ndarray,
 
 #: Patches per step of ``_patch_sums``: its (3, n, T) temporaries stay a few MB, in the CPU's
 #: cache and in memory the process has (30k patches at once: 24 MB each, bench/RESULTS.md
-#: "Issue 15: the 30k-patch PLY cold", session 8).
-VOLUME_PATCHES_PER_STEP = 2048
+#: "Issue 15: the 30k-patch PLY cold and warm (session 8)").
+VOLUME_PATCHES_PER_STEP = 2048  # 4 or more (_patch_sums)
 
 
 def _patch_sums(points: np.ndarray, grid: np.ndarray):

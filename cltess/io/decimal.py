@@ -11,7 +11,7 @@ significant bits and is an extended number, so a midpoint strictly between the e
 its extended rounding would be nearer to the exact value, which contradicts the rounding.  The
 few tokens whose extended result *is* a midpoint (the low 11 of its 64 significand bits
 ``10000000000``), and any outside those limits, go to ``float`` (David Gay's correctly rounded
-conversion).  Design notes: docs/design.md section 13.
+conversion).  Design notes: docs/design.md section 9, "The numbers themselves".
 """
 from __future__ import annotations
 

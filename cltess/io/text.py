@@ -163,7 +163,7 @@ _DIGITS = _byte_set(b"0123456789")
 _COMMA_TO_SPACE = bytes.maketrans(b",", b" ")
 #: Bytes per piece the tokens are found and converted in (whole lines): the temporaries of a
 #: piece stay in memory the process already has (fresh pages cost more than the work here:
-#: bench/RESULTS.md, "The text parser, session 8").
+#: bench/RESULTS.md, "Issue 15: the 30k-patch PLY cold and warm (session 8)").
 PIECE_BYTES = 1 << 20
 
 
