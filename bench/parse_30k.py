@@ -45,9 +45,11 @@ print(parsed[0] - start[0], parsed[1] - start[1], done[0] - parsed[0], done[1] -
 
 
 def child(tree: Path, scene: Path) -> list:
+    """One child on ``tree``'s code: PYTHONPATH, and a working folder without a ``cltess``
+    (``python -c`` puts the working folder first on sys.path, before PYTHONPATH)."""
     env = dict(os.environ, PYTHONPATH=str(tree))
-    out = subprocess.run([sys.executable, "-c", CHILD, str(scene)], env=env, capture_output=True, text=True,
-                         check=True).stdout.split()
+    out = subprocess.run([sys.executable, "-c", CHILD, str(scene)], env=env, cwd=scene.parent, capture_output=True,
+                         text=True, check=True).stdout.split()
     return [float(out[0]), int(out[1]), float(out[2]), int(out[3]), out[4], out[5]]
 
 
