@@ -67,13 +67,20 @@ CPU_SECONDS: list = []  # (user + system) CPU seconds of each child run, in run 
 LOADS: list = []  # the 1-minute load average as each child run started
 
 
+#: The tree whose code "this tree"'s children run (PYTHONPATH), and the folder they all run in:
+#: not a checkout, since ``python -m`` and ``-c`` put the working folder first on sys.path,
+#: before PYTHONPATH (run from a checkout, the baseline's children ran that checkout's code).
+TREE = Path(__file__).resolve().parent.parent
+CHILD_FOLDER = [None]
+
+
 def run_child(command: list[str], env: dict) -> float:
     """Wall seconds of a child process; its CPU seconds (user + system, all its threads) are
     appended to CPU_SECONDS."""
     LOADS.append(os.getloadavg()[0])
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     started = time.perf_counter()
-    done = subprocess.run(command, env=env, capture_output=True, text=True)
+    done = subprocess.run(command, env=env, capture_output=True, text=True, cwd=CHILD_FOLDER[0])
     wall = time.perf_counter() - started
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     CPU_SECONDS.append(after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
@@ -187,6 +194,7 @@ def main() -> int:
     SPACING[0] = args.spacing
     with tempfile.TemporaryDirectory(dir=args.folder or ".") as folder:
         folder = Path(folder)
+        CHILD_FOLDER[0] = folder
         scene = folder / "teapots30k.bpt"
         write_scene(scene)
         out, base_out = folder / "out.ply", folder / "out-baseline.ply"
@@ -202,7 +210,8 @@ def main() -> int:
                 walls, baseline, peers, imports = [], [], [], []
                 for _ in range(args.repeat):
                     cache = folder / f"cache-{orient}-{len(walls)}"  # cold: a fresh cache each run
-                    env = dict(os.environ, CLTESS_SCENE_CACHE=str(cache if state == "cold" else folder / "cache"))
+                    env = dict(os.environ, PYTHONPATH=str(TREE),
+                               CLTESS_SCENE_CACHE=str(cache if state == "cold" else folder / "cache"))
                     if state == "warm" and not walls:
                         run_cli([str(scene), orient, *base], env)  # fills the warm cache
                     walls.append(run_cli([str(scene), orient, *base], env))

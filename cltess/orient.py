@@ -161,11 +161,8 @@ def _signed_volumes(points: np.ndarray, grid: np.ndarray, component: np.ndarray,
     centre first (against cancellation far from the origin).  The sums are taken per patch,
     then per component (bincount)."""
     points = points - points.reshape(3, -1).mean(axis=1)[:, None, None]
-    a, b, d = (points[:, :, grid[:, k]] for k in range(3))  # (3, P, T) each
-    b_x_d = _cross(b, d)
-    determinant = (a * b_x_d).sum(axis=(0, 2)) * sign
-    twice_area = (_cross(a, b) + b_x_d + _cross(d, a)).sum(axis=2) * sign
-    corner_sum = (a + b + d).sum(axis=2)
+    determinant, twice_area, corner_sum = _patch_sums(points, grid)
+    determinant, twice_area = determinant * sign, twice_area * sign
 
     def per_component(values):
         return np.bincount(component, values, minlength=count)
@@ -183,6 +180,29 @@ def _signed_volumes(points: np.ndarray, grid: np.ndarray, component: np.ndarray,
         high[present] = np.maximum.reduceat(points.max(axis=2).T[order], start)
     size = np.linalg.norm(np.where(np.isfinite(high - low), high - low, 0), axis=1)
     return (per_component(determinant) - (centre * area).sum(axis=1)) / 6, size
+
+
+#: Patches per step of ``_patch_sums``: its (3, n, T) temporaries stay a few MB, in the CPU's
+#: cache and in memory the process has (30k patches at once: 24 MB each, bench/RESULTS.md
+#: "Issue 15: the 30k-patch PLY cold and warm (session 8)").
+VOLUME_PATCHES_PER_STEP = 2048  # 4 or more (_patch_sums)
+
+
+def _patch_sums(points: np.ndarray, grid: np.ndarray):
+    """Per patch: sum of det(a, b, d), (3, P) sum of a x b + b x d + d x a, (3, P) sum of
+    a + b + d over its triangles (a, b, d) (``grid`` over ``points``), a few patches at a time.
+    The same bits as all at once: each patch's sums are taken in the same order whatever the
+    step (no step has one patch unless the scene has, where NumPy would merge axes)."""
+    count = points.shape[1]
+    determinant, twice_area, corner_sum = np.empty(count), np.empty((3, count)), np.empty((3, count))
+    for part in np.array_split(np.arange(count), max(1, -(-count // VOLUME_PATCHES_PER_STEP))):
+        part = slice(part[0], part[-1] + 1) if len(part) else slice(0, 0)
+        a, b, d = (points[:, part][:, :, grid[:, k]] for k in range(3))  # (3, n, T) each
+        b_x_d = _cross(b, d)
+        determinant[part] = (a * b_x_d).sum(axis=(0, 2))
+        twice_area[:, part] = (_cross(a, b) + b_x_d + _cross(d, a)).sum(axis=2)
+        corner_sum[:, part] = (a + b + d).sum(axis=2)
+    return determinant, twice_area, corner_sum
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -108,3 +108,29 @@ def test_the_scene_cache_gives_the_parsed_patches_back(tmp_path, rng, monkeypatc
     assert len(list(cache.iterdir())) == 2
     monkeypatch.setenv("CLTESS_SCENE_CACHE", "off")
     assert scene_cache.cache_folder() is None
+
+
+def test_a_cache_miss_hashes_the_file_once_unless_it_changed(tmp_path, rng, monkeypatch):
+    """The key hashed from the file's mapping is reused for the entry a miss stores, unless the
+    file changed in between (then the bytes read are hashed): either way the entry is the one a
+    later read looks up."""
+    from cltess.io import scene_cache
+
+    monkeypatch.setenv("CLTESS_SCENE_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setattr(scene_cache, "MIN_BYTES", 0)
+    hashed = []
+    key = scene_cache._key
+    monkeypatch.setattr(scene_cache, "_key", lambda data: hashed.append(len(data)) or key(data))
+    path = tmp_path / "p.bpt"
+    bpt.write(path, random_patches(rng, 20, False))
+    first = bpt.read(path).patches
+    assert len(hashed) == 1 and len(list((tmp_path / "cache").iterdir())) == 1
+    assert bpt.read(path).patches.tobytes() == first.tobytes() and len(hashed) == 2  # a hit
+    bpt.write(path, random_patches(rng, 20, False))
+    monkeypatch.setattr(scene_cache, "_version", lambda path: "changed since it was hashed")
+    second = bpt.read(path).patches
+    assert len(hashed) == 4 and len(list((tmp_path / "cache").iterdir())) == 2
+    monkeypatch.undo()
+    monkeypatch.setenv("CLTESS_SCENE_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setattr(scene_cache, "MIN_BYTES", 0)
+    assert bpt.read(path).patches.tobytes() == second.tobytes() and len(list((tmp_path / "cache").iterdir())) == 2

@@ -155,3 +155,19 @@ def test_a_large_scenes_orientation_and_edge_groups_come_back_from_the_cache(tmp
     with pytest.raises(TypeError):  # not in the cache: orientation_flips (the spy) is asked
         orient_scene(reversed_u(teapot, np.zeros(teapot.num_patches, bool)))
     assert calls
+
+
+@pytest.mark.parametrize("count", [1, 2, 3, 4, 9, 64, 65, 130])
+def test_volume_sums_a_few_patches_at_a_time_are_those_of_all_at_once(rng, monkeypatch, count):
+    """orient._patch_sums in steps (any step of 4 or more) against the sums over all patches
+    at once, bitwise (NumPy's reference: the formula of _signed_volumes' docstring)."""
+    from cltess import orient
+
+    points, grid = orient._bezier_samples(rng.normal(size=(count, 4, 4, 4)) + [0, 0, 0, 3])
+    a, b, d = (points[:, :, grid[:, k]] for k in range(3))
+    b_x_d = orient._cross(b, d)
+    whole = [(a * b_x_d).sum(axis=(0, 2)), (orient._cross(a, b) + b_x_d + orient._cross(d, a)).sum(axis=2),
+             (a + b + d).sum(axis=2)]
+    for step in (4, 5, 7, 64):
+        monkeypatch.setattr(orient, "VOLUME_PATCHES_PER_STEP", step)
+        assert [s.tobytes() for s in orient._patch_sums(points, grid)] == [s.tobytes() for s in whole]

@@ -58,12 +58,13 @@ def _load_entry(entry: Path) -> np.ndarray | None:
     return None
 
 
-def cached_patches(data: bytes, kind: str, parse: Callable[[bytes], np.ndarray]) -> np.ndarray:
-    """``parse(data)``, or the patches a previous parse of the same bytes stored."""
+def cached_patches(data: bytes, kind: str, parse: Callable[[bytes], np.ndarray], key: str | None = None) -> np.ndarray:
+    """``parse(data)``, or the patches a previous parse of the same bytes stored (``key``: the
+    bytes' ``_key`` where the caller has it already)."""
     folder = cache_folder() if len(data) >= MIN_BYTES else None
     if folder is None:
         return parse(data)
-    entry = _entry(folder, _key(data), kind)
+    entry = _entry(folder, key or _key(data), kind)
     patches = _load_entry(entry)
     if patches is not None:
         return patches
@@ -82,36 +83,51 @@ def read_patch_file(path, kind: str, fast: Callable[[bytes], np.ndarray | None],
     """A patch file's (P, 4, 4, 4) homogeneous patches: ``fast(data)`` (NumPy at once; None for
     anything it would not take), else ``slow`` line by line (which names the line at fault); a
     large file's from this cache when the same bytes were parsed before."""
-    folder = cache_folder()
+    folder, key = cache_folder(), None
     if folder is not None:  # a hit is found from the file's mapped pages: no copy of the bytes
         check_scene_file(path)  # not a FIFO or device, which open() would block on or map
-        hit = _hit_of_mapped(path, folder, kind)
+        key, version = _key_of_mapped(path)
+        hit = None if key is None else _load_entry(_entry(folder, key, kind))
         if hit is not None:
             return hit
     data = _read_bytes(path)
+    if key is not None and _version(path) != version:  # changed since it was hashed: hash what was read
+        key = None
 
     def parse(data):
         patches = fast(data)
         return patches if patches is not None else slow(_Lines(str(path), _decode(path, data)))
 
-    return cached_patches(data, kind, parse)
+    return cached_patches(data, kind, parse, key)
 
 
-def _hit_of_mapped(path, folder: Path, kind: str) -> np.ndarray | None:
-    """The cached patches of the file at ``path`` if it is large and was parsed before, its
-    key hashed from a read-only mapping; None otherwise (also for anything unusual: the file
-    is then read and reported as without the cache)."""
+def _key_of_mapped(path) -> tuple[str | None, tuple | None]:
+    """The ``_key`` of the file at ``path`` if it is large enough to be cached, hashed from a
+    read-only mapping, and the file's ``_version`` then; (None, None) otherwise (also for
+    anything unusual: the file is then read and reported as without the cache)."""
     import mmap
 
     try:
         with open(path, "rb") as handle:
-            if os.fstat(handle.fileno()).st_size < MIN_BYTES:
-                return None
+            status = os.fstat(handle.fileno())
+            if status.st_size < MIN_BYTES:
+                return None, None
             with mmap.mmap(handle.fileno(), 0, access=mmap.ACCESS_READ) as mapped:
-                key = _key(mapped)
+                return _key(mapped), _version_of(status)
     except (OSError, ValueError):
+        return None, None
+
+
+def _version(path) -> tuple | None:
+    """What tells a changed file (device, inode, size, change and modification times in ns)."""
+    try:
+        return _version_of(os.stat(path))
+    except OSError:
         return None
-    return _load_entry(_entry(folder, key, kind))
+
+
+def _version_of(status: os.stat_result) -> tuple:
+    return status.st_dev, status.st_ino, status.st_size, status.st_mtime_ns, status.st_ctime_ns
 
 
 def derived(scene, what: str, sources: list, make: Callable[[], dict]) -> dict:

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ..scene import SceneError, check_scene_file
+from . import decimal
 
 INT32_MAX = 2**31 - 1
 
@@ -148,16 +149,22 @@ def _cartesian_rows(patches: np.ndarray) -> np.ndarray:
 
 # --- the fast path: a whole file of plain decimal numbers parsed by NumPy ---------------------
 
+_NUMBER_FILE_BYTES = b"0123456789eE.+- \t\n"
+_NUMBER_FILE_BYTES_COMMA = _NUMBER_FILE_BYTES + b","
+
+
 def _byte_set(chars: bytes) -> np.ndarray:
     table = np.zeros(256, bool)
     table[list(chars)] = True
     return table
 
 
-_NUMBER_FILE_BYTES = _byte_set(b"0123456789eE.+- \t\n")
-_NUMBER_FILE_BYTES_COMMA = _byte_set(b"0123456789eE.+-, \t\n")
 _DIGITS = _byte_set(b"0123456789")
 _COMMA_TO_SPACE = bytes.maketrans(b",", b" ")
+#: Bytes per piece the tokens are found and converted in (whole lines): the temporaries of a
+#: piece stay in memory the process already has (fresh pages cost more than the work here:
+#: bench/RESULTS.md, "Issue 15: the 30k-patch PLY cold and warm (session 8)").
+PIECE_BYTES = 1 << 20
 
 
 class _Numbers:
@@ -170,7 +177,8 @@ class _Numbers:
     ``_Numbers.of`` returns None for anything unusual (a byte outside ASCII digits, signs,
     ``.``, ``e``, ``E``, spaces, tabs, newlines (and commas); a token that is not one number
     read to its end; a non-finite value): the readers then parse line by line, which
-    finds the first problem and names its line.  Values are correctly rounded, as ``float``.
+    finds the first problem and names its line.  Values are correctly rounded, as ``float``
+    (io/decimal.py).
     """
 
     def __init__(self, data, values, start, lengths, per_line, commas):
@@ -182,16 +190,50 @@ class _Numbers:
     def of(data: bytes, commas: bool = False) -> "_Numbers | None":
         if b"\r" in data:  # line ends as _Lines counts them
             data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
-        chars = np.frombuffer(data, np.uint8)
-        if not len(chars) or not (_NUMBER_FILE_BYTES_COMMA if commas else _NUMBER_FILE_BYTES)[chars].all():
+        if not data or data.translate(None, _NUMBER_FILE_BYTES_COMMA if commas else _NUMBER_FILE_BYTES):
             return None
-        newline = chars == 10
-        comma = chars == 44
-        gap = (chars == 32) | (chars == 9) | newline | comma
-        gap_before = np.concatenate(([True], gap[:-1]))
-        gap_after = np.concatenate((gap[1:], [True]))
-        start = np.flatnonzero(~gap & gap_before)
-        end = np.flatnonzero(~gap & gap_after)
+        if not decimal.EXTENDED:
+            return _Numbers._of_fromstring(data, commas)
+        # Outputs sized for the most tokens the bytes can hold: pages no token reaches are
+        # never touched (no copy of per-piece parts, and no fresh memory beyond the results).
+        most = len(data) // 2 + 1
+        values, start, lengths = np.empty(most), np.empty(most, np.int64), np.empty(most, np.int64)
+        per_line, commas_per_line = [], []
+        count = offset = 0
+        while offset < len(data):  # pieces of whole lines
+            cut = data.find(b"\n", offset + PIECE_BYTES) + 1 or len(data)
+            piece = data[offset:cut]
+            begin, end, newlines, comma = _tokens(piece, commas)
+            numbers = decimal.parse_decimals(piece, begin, end)
+            if numbers is None:
+                return None
+            values[count:count + len(numbers)] = numbers
+            start[count:count + len(numbers)] = begin + offset
+            lengths[count:count + len(numbers)] = end - begin
+            count += len(numbers)
+            # the tokens on each physical line of the piece: the newlines before a token (a binary
+            # search among them) are its line; a piece's last slot is a line the next one goes on
+            per_line.append(np.bincount(np.searchsorted(newlines, begin), minlength=len(newlines) + 1))
+            if commas:
+                commas_per_line.append(np.bincount(np.searchsorted(newlines, comma), minlength=len(newlines) + 1))
+            offset = cut
+        values, start, lengths, per_line = values[:count], start[:count], lengths[:count], np.concatenate(per_line)
+        if not count or not np.isfinite(values).all():
+            return None
+        lines = np.flatnonzero(per_line)
+        if commas:
+            commas_per_line = np.concatenate(commas_per_line)
+            if commas_per_line[per_line == 0].any():  # a comma on a line of no token
+                return None
+            commas_per_line = commas_per_line[lines]
+        return _Numbers(np.frombuffer(data, np.uint8), values, start, lengths, per_line[lines],
+                        commas_per_line if commas else None)
+
+    @staticmethod
+    def _of_fromstring(data: bytes, commas: bool) -> "_Numbers | None":
+        """The same without an x87 long double (io/decimal.py EXTENDED): ``np.fromstring``
+        (strtod token after token) for the values."""
+        start, end, newlines, comma = _tokens(data, commas)
         if not len(start):
             return None
         # strtod token after token: a token it cannot read to its end leaves a remainder that is
@@ -207,22 +249,15 @@ class _Numbers:
             return None
         if len(values) != len(start) or not np.isfinite(values).all():
             return None
-        # The physical line (0-based) of a byte that is no newline: the newlines before it, found
-        # by a binary search among the newlines' offsets (a cumulative count over every byte
-        # took 0.4 s of the 30k-patch scene's 19.6 MB, this 0.03 s: bench/RESULTS.md, session 4).
-        newlines = np.flatnonzero(newline)
-        line = np.searchsorted(newlines, start)  # a token's line
-        per_line = np.bincount(line)
+        per_line = np.bincount(np.searchsorted(newlines, start))
         lines = np.flatnonzero(per_line)
+        commas_per_line = None
         if commas:
-            commas_per_line = np.bincount(np.searchsorted(newlines, np.flatnonzero(comma)),
-                                          minlength=len(per_line))[:len(per_line)]
-            if commas_per_line.sum() != np.count_nonzero(comma):  # a comma on a line of no token
-                return None
+            commas_per_line = np.bincount(np.searchsorted(newlines, comma), minlength=len(per_line))
+            if len(commas_per_line) > len(per_line) or commas_per_line[per_line == 0].any():
+                return None  # a comma on a line of no token
             commas_per_line = commas_per_line[lines]
-        else:
-            commas_per_line = None
-        return _Numbers(chars, values, start, end - start + 1, per_line[lines], commas_per_line)
+        return _Numbers(np.frombuffer(data, np.uint8), values, start, end - start, per_line[lines], commas_per_line)
 
     def integer_token(self, k: int) -> int | None:
         """Token k as a positive integer if it is plain digits (at most 18), else None."""
@@ -239,3 +274,21 @@ class _Numbers:
         end_token = self.first[last_line - 1] + self.per_line[last_line - 1] - 1
         end = int(self.start[end_token] + self.lengths[end_token])
         return bool(table[self.data[begin:end]].all())
+
+
+def _tokens(text: bytes, commas: bool):
+    """Token offsets of a text of number bytes (_NUMBER_FILE_BYTES): start (N,) and end (N,
+    exclusive); the offsets of its newlines and (comma files) of its commas."""
+    chars = np.frombuffer(text, np.uint8)
+    gap = chars <= 32  # space, tab, newline: the only such bytes here
+    comma = None
+    if commas:
+        comma = np.flatnonzero(chars == 44)
+        gap[comma] = True
+    begins = np.empty(len(chars), bool)  # a gap, then a token byte
+    begins[0] = not gap[0]
+    np.greater(gap[:-1], gap[1:], out=begins[1:])
+    ends = np.empty(len(chars), bool)  # a token byte, then a gap (or the end)
+    ends[-1] = not gap[-1]
+    np.less(gap[:-1], gap[1:], out=ends[:-1])
+    return np.flatnonzero(begins), np.flatnonzero(ends) + 1, np.flatnonzero(chars == 10), comma

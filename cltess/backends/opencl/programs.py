@@ -12,6 +12,7 @@ from __future__ import annotations
 import os
 import shlex
 from dataclasses import dataclass
+from functools import cached_property
 from importlib import resources
 from pathlib import Path
 
@@ -226,23 +227,30 @@ class Programs:
         self.keep_arguments = False
         #: A list to which every launch is appended (``Launch``) while a Session records a frame.
         self.recording = None
-        self.offsets_scan = GenericScanKernel(
-            context, np.uint64, arguments="__global const ulong *counts, __global ulong *offsets",
+        self._summary_scan = None
+
+    @cached_property
+    def offsets_scan(self) -> GenericScanKernel:
+        """Exclusive offsets of uint64 counts (built on first use: pyopencl builds its programs)."""
+        return GenericScanKernel(
+            self.context, np.uint64, arguments="__global const ulong *counts, __global ulong *offsets",
             input_expr="counts[i]", scan_expr="a+b", neutral="0",
             output_statement="offsets[i + 1] = item;")
-        # Stage 3's vertex and index offsets in one scan of (vertex, index) pairs: a struct of two
-        # ulongs (8-byte aligned; a ulong2 was stored misaligned in the scan's local memory).
-        pair, declaration = match_dtype_to_c_struct(context.devices[0], "offset_pair",
+
+    @cached_property
+    def offsets_pair_scan(self) -> GenericScanKernel:
+        """Stage 3's vertex and index offsets in one scan of (vertex, index) pairs: a struct of
+        two ulongs (8-byte aligned; a ulong2 was stored misaligned in the scan's local memory)."""
+        pair, declaration = match_dtype_to_c_struct(self.context.devices[0], "offset_pair",
                                                     np.dtype([("v", np.uint64), ("i", np.uint64)]))
         pair = get_or_register_dtype("offset_pair", pair)
-        self.offsets_pair_scan = GenericScanKernel(
-            context, pair, preamble=declaration + OFFSET_PAIR_FUNCTIONS,
+        return GenericScanKernel(
+            self.context, pair, preamble=declaration + OFFSET_PAIR_FUNCTIONS,
             arguments="__global const ulong *vertex_counts, __global const ulong *index_counts, "
                       "__global ulong *vertex_offsets, __global ulong *index_offsets",
             input_expr="offset_pair_of(vertex_counts[i], index_counts[i])", scan_expr="offset_pair_add(a, b)",
             neutral="offset_pair_of(0, 0)",
             output_statement="vertex_offsets[i + 1] = item.v; index_offsets[i + 1] = item.i;")
-        self._summary_scan = None
 
     def summary_scan(self) -> GenericScanKernel:
         """Stage 3's one scan that also writes a frame's summary (built on first use): the
