@@ -1,17 +1,15 @@
 """The tie zone's weights (w, lam) of kernels/patterns/sd2.h sd2_morph against the NumPy mirror
 cltess/patterns/sd2.py sd2_morph, bitwise, on hinted records chosen to reach every branch of the
-sharpening near odd whole factors (docs/sd2.md section 5, "Seventh pass") and of the spread away
-from them ("Eighth pass"): plateaus at odd whole numbers left by one or two corners (sigma_m = 0,
-kappa from sigma alone, down to 0 at a tie), isolated triple ties just off odd numbers (kappa
-from sigma_m / rho, the spread's weight partly and wholly on), ties with c+1 and c+2 (lam exactly
-1 and 0), and random zone records."""
+sharpening near odd whole factors (docs/sd2.md section 5, "Seventh pass"): plateaus at odd whole
+numbers left by one or two corners (sigma_m = 0, kappa from sigma alone, down to 0 at a tie),
+isolated triple ties just off odd numbers (kappa from sigma_m / rho), ties with c+1 and c+2
+(lam exactly 1 and 0), and random zone records."""
 import numpy as np
 import pyopencl as cl
 
 from cltess.backends.opencl.programs import correctly_rounded_division, kernel_dir
 from cltess.patterns.fractional import FIXED_ONE
-from cltess.patterns.sd2 import (HINT_SHIFT, _odd_apart, _sharpen, _spread_lam, _switch_width, odd_distance, sd2_hint,
-                                 sd2_morph, sd2_shape)
+from cltess.patterns.sd2 import HINT_SHIFT, _sharpen, _switch_width, odd_distance, sd2_morph, sd2_shape
 
 KERNEL = """
 __kernel void morph(__global const int4 *records, int count, __global int *zone, __global float2 *weights)
@@ -67,7 +65,7 @@ def test_zone_weights_equal_the_mirror_bitwise(tessellator, rng):
     program.morph(queue, (len(recs),), None, source, np.int32(len(recs)), *outs)
     for host, buf in zip((zone, weights), outs):
         cl.enqueue_copy(queue, host, buf)
-    sharpened = spread_partly = 0
+    sharpened = 0
     for k, f in enumerate(recs):
         shape, tip = sd2_shape(f)
         if shape != "sd2":
@@ -78,10 +76,7 @@ def test_zone_weights_equal_the_mirror_bitwise(tessellator, rng):
         if inside:
             assert weights[k].view(np.uint32).tolist() == np.array([w, lam], np.float32).view(np.uint32).tolist(), f
             sharpened += 0.0 < lam < 1.0
-            m, phi_m = sd2_hint(f)
-            spread_partly += 1.0 < _odd_apart(int(f[tip]), phi_m) < 2.0  # 0 < the spread's weight < 1
     assert sharpened > 50 and (zone == 1).sum() > 1000  # the zone and the steep part were drawn
-    assert spread_partly > 20, spread_partly
 
 
 def test_sharpening_keeps_the_ends_and_is_the_step_at_width_0():
@@ -105,30 +100,3 @@ def test_switch_width():
     assert _switch_width(3 * one + one // 8 + one // 64, 3 * one + one // 8) == 1.0  # an isolated triple tie at 3 1/8
     assert _switch_width(3 * one + one // 64, 3 * one) == np.float32(0.125)  # a plateau of 3 left by 1/64
     assert _switch_width(3 * one + one // 16, 3 * one) == np.float32(0.5)
-
-
-def test_spread_keeps_the_ends_and_lam_where_the_configurations_agree():
-    """_spread_lam (docs/sd2.md section 5, "Eighth pass"): 0 at e2 = 0 and 1 at e1 = 0 for every
-    weight; lam bitwise wherever sigma_m <= rho (odd plateaus, near odd triple ties); e2 / (e1 + e2)
-    (to a rounding) where sigma_m >= 2 rho; always in [0, 1]."""
-    one, f32 = FIXED_ONE, np.float32
-    rng = np.random.default_rng(13)
-    for _ in range(2000):
-        phi_m = int(rng.integers(one, 20 * one))
-        e1, e2 = (int(x) for x in rng.integers(0, one, 2))
-        big = phi_m + max(e1, e2, 1)
-        lam = min(f32(f32(e2) / f32(e1)), f32(1.0)) if e1 > 0 else f32(1.0)
-        out = _spread_lam(lam, e1, e2, big, phi_m)
-        assert 0.0 <= out <= 1.0
-        apart = _odd_apart(big, phi_m)
-        if apart <= 1.0:
-            assert out == lam
-        if apart >= 2.0:  # lam + (spread - lam): within a rounding of the spread
-            assert abs(out - f32(f32(e2) / f32(e1 + e2))) <= 1.2e-7
-    for phi_m in (2 * one, 2 * one + one // 3, 4 * one, 3 * one, 3 * one + 7):
-        for e in (1, 100, one // 2, one - 1):
-            assert _spread_lam(f32(0.0), e, 0, phi_m + e, phi_m) == 0.0  # the tie with c+2
-            assert _spread_lam(f32(1.0), 0, e, phi_m + e, phi_m) == 1.0  # the tie with c+1
-    # a plateau at 3 left by the tip (e1 = e2): lam stays 1 (its grid); at 2.5 it is spread to 1/2
-    assert _spread_lam(f32(1.0), 500, 500, 3 * one + 500, 3 * one) == 1.0
-    assert _spread_lam(f32(1.0), 500, 500, 5 * one // 2 + 500, 5 * one // 2) == 0.5

@@ -84,10 +84,7 @@ def sd2_morph(f, c: int) -> tuple[bool, np.float32, np.float32]:
     c+2, ``min(e2 / e1, 1)``, e_k = F - phi_k the distance of base corner k from tying with the
     tip: 1 at e1 = 0, 0 at e2 = 0, continuous elsewhere, and 1 when the base corners tie with each
     other (e1 = e2: a plateau left by the tip starts from the tie configuration with partner c+1,
-    which at an odd whole factor is the plateau's grid); spread towards ``e2 / (e1 + e2)`` away
-    from the odd whole factors (_spread_lam; docs/sd2.md section 5, "Eighth pass"), so that a path
-    passing an isolated triple tie there moves between the configurations over twice the angle;
-    then sharpened about 1/2 near a triple
+    which at an odd whole factor is the plateau's grid); then sharpened about 1/2 near a triple
     tie at an odd whole factor of 3 or more (_sharpen to width _switch_width; docs/sd2.md
     section 5, "Seventh pass"), where a blend of the two configurations slides each vertex by up to
     n lattice cells while the configurations themselves are nearly the same lattice.  Outside the
@@ -102,7 +99,6 @@ def sd2_morph(f, c: int) -> tuple[bool, np.float32, np.float32]:
     e1, e2 = (e_m, e_other) if m == (c + 1) % 3 else (e_other, e_m)
     w = np.float32(e_other) * np.float32(1.0 / FIXED_ONE)
     lam = min(np.float32(np.float32(e2) / np.float32(e1)), np.float32(1.0)) if e1 > 0 else np.float32(1.0)
-    lam = _spread_lam(lam, e1, e2, big, phi_m)
     return True, w, _sharpen(lam, _switch_width(big, phi_m))
 
 
@@ -134,35 +130,9 @@ def _switch_width(big: int, phi_m: int) -> np.float32:
     rho = int(big) - int(phi_m)
     if rho <= 0 or phi_m < 2 * FIXED_ONE:
         return np.float32(1.0)
-    apart = _odd_apart(big, phi_m)
+    apart = np.float32(np.float32(odd_distance(phi_m)) / np.float32(rho))
     from_tie = np.float32(np.float32(np.float32(rho) * np.float32(1.0 / FIXED_ONE)) / np.float32(SWITCH_REACH))
     return min(np.float32(1.0), max(from_tie, apart))
-
-
-def _odd_apart(big: int, phi_m: int) -> np.float32:
-    """``sigma_m / rho``: how far phi_m lies from the nearest odd whole number, in units of rho =
-    F - phi_m, the fan's distance from the triple tie (rho > 0 in a fan: rho = 0 would make all
-    three factors equal, the grid).  Small near a triple tie at an odd whole number, large near an
-    isolated one off them.  Device: sd2.h sd2_odd_apart, the same operations."""
-    return np.float32(np.float32(odd_distance(phi_m)) / np.float32(int(big) - int(phi_m)))
-
-
-def _spread_lam(lam: np.float32, e1: int, e2: int, big: int, phi_m: int) -> np.float32:
-    """lam = min(e2 / e1, 1) moved towards ``e2 / (e1 + e2)`` by
-    ``g = clamp(sigma_m / rho - 1, 0, 1)`` (_odd_apart; docs/sd2.md section 5, "Eighth pass"):
-    ``lam + g (e2 / (e1 + e2) - lam)``.  Around a triple tie, in the quadrant e1, e2 >= 0, lam goes
-    from 0 (e2 = 0, the tie with c+2) to 1 (e1 = 0, the tie with c+1) within the half e2 <= e1
-    (steepest 2 per radian), e2 / (e1 + e2) over the whole quadrant (steepest 1): a path passing an
-    isolated triple tie off the odd numbers, where the two tie configurations differ by about the
-    error, moves between them over twice the angle.  g = 0 wherever sigma_m <= rho, so lam is kept
-    bitwise where _switch_width sharpens it (near triple ties at odd whole numbers, where a blend
-    stands off both configurations) and on plateaus at odd whole numbers (where e1 = e2 must give
-    1).  Both ends (0 at e2 = 0, 1 at e1 = 0) are kept everywhere, and the result lies in [0, 1].
-    e1 + e2 >= rho > 0 in a fan.  Device: sd2.h sd2_spread_lam, the same operations."""
-    f32 = np.float32
-    spread = f32(f32(e2) / f32(int(e1) + int(e2)))
-    g = min(f32(1.0), max(f32(_odd_apart(big, phi_m) - f32(1.0)), f32(0.0)))
-    return f32(lam + f32(g * f32(spread - lam)))
 
 
 def _sharpen(lam: np.float32, kappa: np.float32) -> np.float32:

@@ -83,28 +83,6 @@ inline int sd2_odd_distance(int x)
     return min(r, 2 * FIXED_ONE - r);
 }
 
-/* sigma_m / rho: phi_m's distance from the nearest odd whole number in units of rho = F - phi_m,
- * the fan's distance from the triple tie (> 0 in a fan; mirror _odd_apart, the same operations). */
-inline float sd2_odd_apart(int big, int phi_m)
-{
-    return (float)sd2_odd_distance(phi_m) / (float)(big - phi_m);
-}
-
-/* lam = min(e2 / e1, 1) moved towards e2 / (e1 + e2) by g = clamp(sigma_m / rho - 1, 0, 1)
- * (docs/sd2.md section 5, "Eighth pass"; mirror _spread_lam, the same operations): a path passing
- * an isolated triple tie off the odd whole factors moves between the two tie configurations over
- * the whole quadrant e1, e2 >= 0 rather than its half e2 <= e1 (steepest 1 per radian, not 2).
- * g = 0 wherever sigma_m <= rho keeps lam bitwise where sd2_switch_width sharpens it and on odd
- * plateaus; lam stays 0 at e2 = 0 and 1 at e1 = 0. */
-inline float sd2_spread_lam(float lam, int e1, int e2, int big, int phi_m)
-{
-    float spread = (float)e2 / (float)(e1 + e2);
-    float g = fmin(1.0f, fmax(sd2_odd_apart(big, phi_m) - 1.0f, 0.0f));
-    float d = spread - lam;
-    float x = g * d;
-    return lam + x;
-}
-
 /* kappa, the width in lam over which the zone moves from one tie configuration to the other
  * (docs/sd2.md section 5, "Seventh pass"; mirror _switch_width, the same operations):
  * min(1, max(rho / SD2_SWITCH_REACH, sigma_m / rho)), rho = F - phi_m the distance from the triple
@@ -118,7 +96,7 @@ inline float sd2_switch_width(int big, int phi_m)
     int rho = big - phi_m;
     if (rho <= 0 || phi_m < 2 * FIXED_ONE)  /* the plateau of 1 moves in proportion already */
         return 1.0f;
-    float apart = sd2_odd_apart(big, phi_m);
+    float apart = (float)sd2_odd_distance(phi_m) / (float)rho;
     float from_tie = (float)rho * (1.0f / (float)FIXED_ONE) / SD2_SWITCH_REACH;
     return fmin(1.0f, fmax(from_tie, apart));
 }
@@ -141,8 +119,7 @@ inline float sd2_sharpen(float lam, float kappa)
 /* The tie zone of the fan with tip c (mirror sd2_morph): 1 when in it, with *w the radial
  * pattern's weight (F - G) / 1.0 and *lam the weight of the tie with partner c+1,
  * min(e2 / e1, 1), e_k = F - phi_k (1 when the base corners tie with each other: a plateau left
- * by the tip starts from one tie configuration, docs/sd2.md section 5), spread towards
- * e2 / (e1 + e2) off the odd whole factors (sd2_spread_lam, "Eighth pass"), sharpened about 1/2 near a
+ * by the tip starts from one tie configuration, docs/sd2.md section 5), sharpened about 1/2 near a
  * triple tie at an odd whole factor of 3 or more (sd2_sharpen to width sd2_switch_width; section 5,
  * "Seventh pass"). */
 inline int sd2_morph(int4 f, int c, float *w, float *lam)
@@ -157,8 +134,7 @@ inline int sd2_morph(int4 f, int c, float *w, float *lam)
     int e1 = m == (c + 1) % 3 ? e_m : e_other, e2 = m == (c + 1) % 3 ? e_other : e_m;
     *w = (float)e_other * (1.0f / (float)FIXED_ONE);
     float ratio = e1 > 0 ? fmin((float)e2 / (float)e1, 1.0f) : 1.0f;
-    float spread = sd2_spread_lam(ratio, e1, e2, big, phi_m);
-    *lam = sd2_sharpen(spread, sd2_switch_width(big, phi_m));
+    *lam = sd2_sharpen(ratio, sd2_switch_width(big, phi_m));
     return 1;
 }
 
