@@ -14,6 +14,9 @@ sequential: leaving the plateau of 3 or 5 with c+2 following after a delay (the 
 triple: a loop of radius r factor units around a triple tie at factor n (phi_k = n + r cos(theta
   + 2 pi k / 3), 72 angles): its diameter (the largest distance between two of its meshes, each
   against every sixth other).  A pop at the triple point: the diameter does not shrink with r.
+passing: a path passing within about 0.01 of a triple tie at n (sphere-320 depth's worst patches
+  pass one at 2.86): the worst step at 0.02 / 0.01 factor units, for two orders of the corners
+  (eighth pass).
 """
 from __future__ import annotations
 
@@ -80,9 +83,24 @@ def sequential(plateaus=(3, 5), rates=(0.3, 0.75), delays=(0.0, 0.005, 0.02), st
                       " / ".join(f"{x:.3f}" for x in worst) + f" of its error at steps {steps}", flush=True)
 
 
+def passing(factors=(2.0, 2.5, 2.86, 3.0, 3.05, 4.0, 5.0, 6.3), steps=(0.02, 0.01)):
+    """Three phi converging to within about 0.01 of n at x = 0.1 and parting again (x in [0, 0.2]):
+    the tip moves, and lam goes from one tie configuration to the other near the point."""
+    error = model.plateau_error(1)
+    for n in factors:
+        for order in ((0, 1, 2), (2, 1, 0)):
+            def at(x):
+                path = [n + 0.1 - x, n - 0.01 + 0.15 * (0.1 - x), n - 0.04 + 0.5 * x]
+                return record([path[order[k]] for k in range(3)])
+            worst = [max(model.lifted_distance(at(x), at(y)) for x, y in zip(xs[:-1], xs[1:])) / error
+                     for xs in (np.arange(0.0, 0.2 + 1e-9, h) for h in steps)]
+            print(f"passing a triple tie at {n}, corners {order}: worst step " + " / ".join(f"{x:.3f}" for x in worst)
+                  + f" of the factor-1 error at steps {steps}", flush=True)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("part", nargs="?", choices=("departures", "triple", "sequential", "both"), default="both")
+    parser.add_argument("part", nargs="?", choices=("departures", "triple", "sequential", "passing", "both"), default="both")
     args = parser.parse_args()
     print(f"tree {TREE}")
     if args.part in ("departures", "both"):
@@ -91,6 +109,8 @@ def main():
         triple()
     if args.part == "sequential":
         sequential()
+    if args.part == "passing":
+        passing()
 
 
 if __name__ == "__main__":
