@@ -160,7 +160,7 @@ class Kernel:
         if changed == () or (changed and keep and self._set_changed(args, changed)):
             # set by the last launch (and the changed ones now): enqueue alone
             event = _cl.enqueue_nd_range_kernel(queue, self.kernel, global_size, local_size, None, None, False, False)
-            if changed:
+            if keep:  # (this tuple from now on: a recorded launch's own, found again by identity)
                 self.kept = args
         else:
             if self.arg_types is None:
