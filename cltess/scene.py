@@ -171,7 +171,8 @@ class Camera:
         right = np.array([f1 * w2 - f2 * w1, f2 * w0 - f0 * w2, f0 * w1 - f1 * w0])  # forward x up
         r0, r1, r2 = (right / math.sqrt(right.dot(right))).tolist()
         u0, u1, u2 = r1 * f2 - r2 * f1, r2 * f0 - r0 * f2, r0 * f1 - r1 * f0  # the true up: right x forward
-        t0, t1, t2 = (-np.array([[r0, r1, r2], [u0, u1, u2], [-f0, -f1, -f2]]) @ eye).tolist()
+        # -rotation @ eye, the negation (exact) made on the Python floats
+        t0, t1, t2 = (np.array([[-r0, -r1, -r2], [-u0, -u1, -u2], [f0, f1, f2]]) @ eye).tolist()
         return np.array([[r0, r1, r2, t0], [u0, u1, u2, t1], [-f0, -f1, -f2, t2], [0.0, 0.0, 0.0, 1.0]], dtype)
 
     def pixel_size_at_unit_depth(self) -> float:
