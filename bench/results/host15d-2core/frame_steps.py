@@ -1,7 +1,7 @@
 """Inclusive thread-CPU µs per overlapped frame by function (wrapped), --as-gpu frames."""
 import sys, time, warnings, statistics, collections, importlib
 sys.path.insert(0, "/work/wt/host15d/bench"); warnings.simplefilter("ignore")
-import pyopencl as cl, pyopencl._cl as _cl
+import pyopencl as cl
 import cltess, frame_loop as fl
 from cltess.backends.opencl import Tessellator
 clock = time.thread_time_ns
@@ -26,12 +26,6 @@ def wrap(owner, name, label=None):
         try: return f(*a, **k)
         finally: T[label] += clock() - s; N[label] += 1
     setattr(owner, name, call)
-import cltess.session as S, cltess.backends.opencl.tessellator as TS, cltess.backends.opencl.programs as P
-import cltess.criteria.tolerance as TO, cltess.scene as SC
-try:
-    import cltess.backends.opencl.recorded as R
-except ImportError:
-    R = None
 for spec in sys.argv[2:]:
     mod, _, rest = spec.rpartition(":")
     parts = rest.split(".")

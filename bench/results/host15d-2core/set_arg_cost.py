@@ -2,7 +2,7 @@
 # on this VM, by pyopencl entry point.  python set_arg_cost.py [pocl]  (Intel CPU runtime by default)
 import sys, time, warnings, statistics
 sys.path.insert(0, "/work/wt/host15d/bench"); warnings.simplefilter("ignore")
-import numpy as np, pyopencl as cl, pyopencl._cl as _cl
+import numpy as np, pyopencl._cl as _cl
 import cltess, frame_loop as fl
 from cltess.backends.opencl import Tessellator
 from cltess.backends.opencl.recorded import with_tolerance
