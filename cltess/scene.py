@@ -142,13 +142,6 @@ def boundary_curves(patches: np.ndarray) -> np.ndarray:
     )
 
 
-def _cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """a x b of two 3-vectors, each component as ``np.cross`` computes it (a1 b2 - a2 b1, ...)."""
-    a0, a1, a2 = a.tolist()
-    b0, b1, b2 = b.tolist()
-    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
-
-
 @dataclass
 class Camera:
     """A pinhole camera for screen-space tolerances (docs/design.md section 7)."""
@@ -162,22 +155,25 @@ class Camera:
     near: float = 0.01
     far: float = 1.0e4
 
-    def view_matrix(self) -> np.ndarray:
-        """World -> camera (4, 4); the camera looks down its -z axis, right-handed.
+    def view_matrix(self, dtype=np.float64) -> np.ndarray:
+        """World -> camera (4, 4) float64, or rounded to ``dtype`` (stage 1's float32); the
+        camera looks down its -z axis, right-handed.
 
-        Once per frame, so on Python floats: the same IEEE operations as ``np.cross`` and
-        ``np.linalg.norm`` (sqrt of the vector's dot with itself), bitwise the same matrix
-        (tests/test_session.py), at a fraction of their call overhead."""
+        Once per frame, so on Python floats but for the three NumPy (BLAS) products: the same
+        IEEE operations as ``np.cross``, ``np.linalg.norm`` (sqrt of the vector's dot with
+        itself) and ``-rotation @ eye`` on the float64 matrix, bitwise the same matrix
+        (tests/test_session.py), at a fraction of their call overhead (a NumPy call costs
+        1-4 µs on this VM's CPUs: bench/RESULTS.md, "Issue 15: a frame's host cost, session 8")."""
         eye = np.asarray(self.eye, float)
         forward = np.asarray(self.target, float) - eye
-        forward /= math.sqrt(forward.dot(forward))
-        right = _cross3(forward, np.asarray(self.up, float))
-        right /= math.sqrt(right.dot(right))
-        true_up = _cross3(right, forward)
-        view = np.zeros((4, 4))  # (np.eye's bits, without its call overhead)
-        view[0, :3], view[1, :3], view[2, :3], view[3, 3] = right, true_up, -forward, 1.0
-        view[:3, 3] = -view[:3, :3] @ eye
-        return view
+        f0, f1, f2 = (forward / math.sqrt(forward.dot(forward))).tolist()
+        w0, w1, w2 = np.asarray(self.up, float).tolist()
+        right = np.array([f1 * w2 - f2 * w1, f2 * w0 - f0 * w2, f0 * w1 - f1 * w0])  # forward x up
+        r0, r1, r2 = (right / math.sqrt(right.dot(right))).tolist()
+        u0, u1, u2 = r1 * f2 - r2 * f1, r2 * f0 - r0 * f2, r0 * f1 - r1 * f0  # the true up: right x forward
+        # -rotation @ eye, the negation (exact) made on the Python floats
+        t0, t1, t2 = (np.array([[-r0, -r1, -r2], [-u0, -u1, -u2], [f0, f1, f2]]) @ eye).tolist()
+        return np.array([[r0, r1, r2, t0], [u0, u1, u2, t1], [-f0, -f1, -f2, t2], [0.0, 0.0, 0.0, 1.0]], dtype)
 
     def pixel_size_at_unit_depth(self) -> float:
         """World length of one pixel at depth 1: ``2 tan(fov_y / 2) / height``."""

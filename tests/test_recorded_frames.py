@@ -2,6 +2,8 @@
 cltess/backends/opencl/recorded.py): replayed frames are bitwise the one-shot results, a record is
 made again when what it was made for changes (buffers grown, the tessellator's settings), and a
 frame that cannot be replayed is made the normal way."""
+from types import SimpleNamespace
+
 import numpy as np
 import pyopencl as cl
 import pytest
@@ -9,9 +11,11 @@ import pytest
 import cltess
 from cltess.backends.opencl import recorded
 from cltess.backends.opencl import tessellator as opencl
-from cltess.backends.opencl.programs import same_arguments
+from cltess.backends.opencl import programs
+from cltess.backends.opencl.programs import changed_arguments, same_arguments
 from cltess.criteria.tolerance import ScreenSpace, camera_arguments
 from cltess.scene import Camera
+from cltess.tessellation import HOST_FIELDS
 from support import assert_same_output
 
 #: (work, stage 3 as on a GPU): the CPU's own path and a GPU's (stage 3 in one launch, or in two)
@@ -164,6 +168,41 @@ def test_same_arguments_compares_values_and_structs_by_their_bytes(rng):
     assert not same_arguments((buffer, np.uint32(8), np.float32(0.5), view(values)), kept)
     assert not same_arguments((buffer, np.int32(7), np.float32(0.5), view(values)), kept)  # another type
     assert not same_arguments(kept[:3], kept) and not same_arguments(kept, None)
+    assert changed_arguments((buffer, np.uint32(8), np.float32(0.5), view(values + 1)), kept) == (1, 3)
+    assert changed_arguments(kept, kept) == () and changed_arguments(kept[:3], kept) is None
+
+
+def test_a_replay_sets_the_changed_arguments_alone(tessellator, tea_table, monkeypatch):
+    """A new camera changes stage 1's view matrix alone: the replay sets that argument (by its
+    bytes, as pyopencl's typed launch does) and enqueues every launch without setting the
+    others, and the frame is still the one-shot result; an argument of another type is set the
+    normal way."""
+    own = gpu_like(tessellator, "point", True)
+    session = cltess.Session(tea_table, tessellator=own, pixels=0.5)
+    cameras = orbit(tea_table.camera, 4)
+    for camera in cameras + cameras:  # the buffers grown to the closest camera's output, then recorded
+        session.tessellate(camera=camera)
+    set_alone, typed = [], []
+    original = programs.Kernel._set_changed
+    monkeypatch.setattr(programs.Kernel, "_set_changed",
+                        lambda self, args, changed: set_alone.append(changed) or original(self, args, changed))
+    typed_launch = cl.Kernel.__call__
+    monkeypatch.setattr(cl.Kernel, "__call__", lambda *a, **k: typed.append(a[0]) or typed_launch(*a, **k))
+    view_at = opencl.TOLERANCE_ARGUMENTS.start + 1  # (eps, view, frustum, pixels, pixel size)
+    frames = []
+    for camera in cameras[-2::-1]:  # (each another camera than the frame before)
+        set_alone.clear(), typed.clear()
+        frame = session.tessellate(camera=camera)
+        assert set_alone == [(view_at,)] and not typed  # a replayed frame: the view alone, no typed launch
+        frames.append({name: np.copy(getattr(frame, name)) for name in HOST_FIELDS})
+    # (a one-shot call launches the same kernels with its own arguments: the next frame sets them all)
+    for camera, frame in zip(cameras[-2::-1], frames):
+        assert_same_output(SimpleNamespace(**frame), own.tessellate(tea_table, request=session.request_for(camera)))
+    (launch,) = session._recorded.launches["factors"]
+    kernel = launch.kernel
+    moved = list(launch.args)
+    moved[view_at] = float(0.0)  # another type than the kernel's: not set alone
+    assert not kernel._set_changed(tuple(moved), (view_at,))
 
 
 def test_camera_arguments_are_the_formulas_bits(rng):

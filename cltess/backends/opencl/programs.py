@@ -80,24 +80,27 @@ WORK_STAGES = {"rows": ("vertex_rows",), "vertex": ("vertex_points",), "point": 
                "auto": ("vertex_points", "prepared_points", "triangles")}
 
 
-def same_arguments(args: tuple, kept: tuple | None) -> bool:
-    """Whether a launch's arguments are those kept from the last one: each the same object, or
-    an equal value of the same type; a NumPy struct (stage 1's float16 view matrix) compared by
-    its bytes, since NumPy's own comparison of two structs cost ~100 µs on this VM's CPUs
-    (bench/RESULTS.md, "Issue 15: a recorded frame")."""
+def changed_arguments(args: tuple, kept: tuple | None) -> tuple | None:
+    """The positions at which a launch's arguments differ from those kept from the last one
+    (None where they cannot be compared: nothing kept, or another count).  Equal: each the same
+    object, or an equal value of the same type; a NumPy struct (stage 1's float16 view matrix)
+    compared by its bytes, since NumPy's own comparison of two structs cost ~100 µs on this VM's
+    CPUs (bench/RESULTS.md, "Issue 15: a recorded frame")."""
     if kept is None or len(args) != len(kept):
-        return False
-    for arg, other in zip(args, kept):
+        return None
+    changed = ()
+    for index, (arg, other) in enumerate(zip(args, kept)):
         if arg is other:
             continue
-        if type(arg) is not type(other):
-            return False
-        if isinstance(arg, np.void):
-            if arg.tobytes() != other.tobytes():
-                return False
-        elif arg != other:
-            return False
-    return True
+        if type(arg) is not type(other) or (
+                arg.tobytes() != other.tobytes() if isinstance(arg, np.void) else arg != other):
+            changed += (index,)
+    return changed
+
+
+def same_arguments(args: tuple, kept: tuple | None) -> bool:
+    """Whether a launch's arguments are those kept from the last one (``changed_arguments``)."""
+    return changed_arguments(args, kept) == ()
 
 
 @dataclass(frozen=True)
@@ -115,8 +118,8 @@ class Launch:
     def again(self, queue, args: tuple | None = None) -> cl.Event:
         """The same launch enqueued again, or with these arguments instead (each set only if
         another launch changed it: ``Kernel``)."""
-        return self.kernel(queue, self.global_size, self.local_size, *(self.args if args is None else args),
-                           **self.options)
+        return self.kernel.launch(queue, self.global_size, self.local_size, self.args if args is None else args,
+                                  self.options)
 
 
 class Kernel:
@@ -131,8 +134,9 @@ class Kernel:
     A launch made while ``Programs.keep_arguments`` is on (a ``Session`` frame) keeps its
     arguments; the next launch with equal arguments (the same buffers, equal scalars: stages 2-5
     of frame after frame) enqueues the kernel alone, without setting them again (issue 15: a
-    frame's host cost).  Any other launch forgets them, so that no buffer outlives its
-    caller for the sake of this.
+    frame's host cost), and one that changes a few of them during a frame (stage 1's camera)
+    sets those alone (``_set_changed``).  Any other launch forgets them, so that no buffer
+    outlives its caller for the sake of this.
     While ``Programs.recording`` is a list, each launch is also appended to it as a ``Launch``
     (a Session records a frame's launches to replay them: cltess/backends/opencl/recorded.py).
     Anything else (``get_work_group_info``, ``function_name``) is the pyopencl kernel's."""
@@ -146,18 +150,50 @@ class Kernel:
         self.kept = None  # the last launch's arguments, still set on the kernel (Programs.keep_arguments)
 
     def __call__(self, queue, global_size, local_size, *args, **options) -> cl.Event:
-        if not options and same_arguments(args, self.kept):  # set by the last launch and unchanged: enqueue alone
+        return self.launch(queue, global_size, local_size, args, options)
+
+    def launch(self, queue, global_size, local_size, args: tuple, options: dict | None = None) -> cl.Event:
+        """``__call__`` with the arguments as a tuple: the kept tuple itself (a recorded launch
+        enqueued again, ``Launch.again``) is known to be set without comparing them."""
+        kept = self.kept
+        changed = None if options or kept is None else () if args is kept else changed_arguments(args, kept)
+        keep = self.programs is not None and self.programs.keep_arguments and not options
+        if changed == () or (changed and keep and self._set_changed(args, changed)):
+            # set by the last launch (and the changed ones now): enqueue alone
             event = _cl.enqueue_nd_range_kernel(queue, self.kernel, global_size, local_size, None, None, False, False)
+            if keep:  # (this tuple from now on: a recorded launch's own, found again by identity)
+                self.kept = args
         else:
             if self.arg_types is None:
                 self.arg_types = tuple(a.dtype if isinstance(a, np.generic) else None for a in args)
                 self.kernel.set_arg_types(self.arg_types)
-            event = self.kernel(queue, global_size, local_size, *args, **options)
-            keep = self.programs is not None and self.programs.keep_arguments and not options
+            event = self.kernel(queue, global_size, local_size, *args, **(options or {}))
             self.kept = args if keep else None
         if self.programs is not None and self.programs.recording is not None:
-            self.programs.recording.append(Launch(self, global_size, local_size, args, options, event))
+            self.programs.recording.append(Launch(self, global_size, local_size, args, options or {}, event))
         return event
+
+    def _set_changed(self, args: tuple, changed: tuple) -> bool:
+        """Set the arguments at ``changed`` alone, as pyopencl's typed launch sets them: memory
+        objects by ``_set_arg_multi``, a NumPy scalar or struct of the kernel's type by its own
+        bytes (``_set_arg_buf_multi``: what ``struct.pack`` of the type makes).  pyopencl's
+        public ``Kernel.set_arg`` took 30-45 µs an argument here (its generic path tries each
+        kind of argument in turn), against 0.6 µs (bench/RESULTS.md, "Issue 15: a frame's host
+        cost, session 8").  False (nothing set) where an argument is neither."""
+        objects, scalars = (), ()
+        for index in changed:
+            arg, arg_type = args[index], self.arg_types[index]
+            if arg_type is None and isinstance(arg, cl.MemoryObjectHolder):
+                objects += (index, arg)
+            elif arg_type is not None and isinstance(arg, np.generic) and arg.dtype == arg_type:
+                scalars += (index, arg)
+            else:
+                return False
+        if objects:
+            self.kernel._set_arg_multi(objects)
+        if scalars:
+            self.kernel._set_arg_buf_multi(scalars)
+        return True
 
     def __getattr__(self, name):
         return getattr(self.kernel, name)

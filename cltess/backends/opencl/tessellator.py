@@ -1389,10 +1389,11 @@ class Plan:
         totals, flags, copies = self._pending
         self.wait_ms += wait_ms(copies)
         self._pending = None
-        self.num_vertices, self.num_indices = int(totals[0]), int(totals[1])
+        totals = totals.tolist()  # (Python ints, in one call)
+        self.num_vertices, self.num_indices = totals[0], totals[1]
         check_totals(self.name, self.num_vertices)
         if flags is None:  # stage 3's summary (Tessellator.stage_counts)
-            culled, saturated = int(totals[2]), int(totals[3])
+            culled, saturated = totals[2], totals[3]
         else:
             culled = int(np.count_nonzero(flags & FLAG_CULLED))
             saturated = int(np.count_nonzero(flags & FLAG_SATURATED))
