@@ -62,7 +62,7 @@ def test_tolerance_is_raised_to_the_float32_floor_where_the_patch_lies(tessellat
     largest coordinate (kernels/criteria/tolerance.h), on the device as in the mirror."""
     from cltess.criteria.tolerance import FLOAT32_TOLERANCE_STEPS
 
-    patches = as_float32(random_patches(rng, 2000, spread=30.0))
+    patches = as_float32(random_patches(rng, 1000, spread=30.0))
     camera = Camera(eye=np.array([90.0, 9.0, 3.0]), target=np.zeros(3), fov_y_deg=40)
     eps = None if pixels else 1e-6
     got, flags = device_factors(tessellator, patches, eps=eps, pixels=pixels, camera=camera, max_factor=4096)
