@@ -354,7 +354,13 @@ def patch_mesh(level: int, edge_masks, collapsed: int = 0):
     """(lattice points (V, 2) int in the device's vertex order, triangles (T, 3) local indices,
     strips uint32 restart-separated local indices) of a patch at level L with the 33 coarse edges'
     masks (canonical directions).  collapsed: bit e for a collapsed patch edge (its points are one
-    position): triangles with a side on it are left out, as the other patterns do."""
+    position): triangles with a side on it are left out, as the other patterns do.  Read-only
+    arrays, shared by the patches with the same record (``_patch_mesh``)."""
+    return _patch_mesh(int(level), tuple(int(mask) for mask in edge_masks), int(collapsed))
+
+
+@lru_cache(maxsize=65536)
+def _patch_mesh(level: int, edge_masks: tuple, collapsed: int):
     n, m = level + 1, 3 * (level + 1)
     tri_points, tris, strips = [], [], []
     for cell, apex, b0, b1, left, right, base in COARSE_TRIANGLES:
@@ -378,7 +384,10 @@ def patch_mesh(level: int, edge_masks, collapsed: int = 0):
     triangles = np.array([[remap(p) for p in t] for t in tris], np.int64).reshape(-1, 3)
     keep = (triangles[:, 0] != triangles[:, 1]) & (triangles[:, 1] != triangles[:, 2]) & (triangles[:, 0] != triangles[:, 2])
     strip_indices = join_strips([[remap(p) for p in s] for s in strips])
-    return np.array(order, np.int64).reshape(-1, 2), triangles[keep], strip_indices
+    mesh = np.array(order, np.int64).reshape(-1, 2), triangles[keep], strip_indices
+    for array in mesh:
+        array.flags.writeable = False
+    return mesh
 
 
 def inserted_points(level: int, edge_masks) -> set:
