@@ -359,7 +359,7 @@ def patch_mesh(level: int, edge_masks, collapsed: int = 0):
     return _patch_mesh(int(level), tuple(int(mask) for mask in edge_masks), int(collapsed))
 
 
-@lru_cache(maxsize=65536)
+@lru_cache(maxsize=4096)  # a level-3 record's mesh is about 10 kB
 def _patch_mesh(level: int, edge_masks: tuple, collapsed: int):
     n, m = level + 1, 3 * (level + 1)
     tri_points, tris, strips = [], [], []
