@@ -52,3 +52,10 @@ def test_pygments_hidden_leaves_an_imported_pygments_alone():
     with pygments_hidden():
         import pygments as within
     assert within is pygments and sys.modules["pygments"] is pygments
+
+
+def test_importing_cltess_leaves_its_version_until_asked():
+    child = ("import cltess\nprint('__version__' in vars(cltess))\n"
+             "from importlib import metadata\nprint(cltess.__version__ == metadata.version('cltess'))")
+    done = subprocess.run([sys.executable, "-c", child], capture_output=True, text=True, check=True)
+    assert done.stdout.split() == ["False", "True"]
