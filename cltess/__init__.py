@@ -4,14 +4,7 @@
 >>> tess = Tessellator().tessellate(load_scene("scenes/teapot.bez"), eps=1e-3)
 >>> export(tess, "teapot.ply")
 """
-from importlib import metadata as _metadata
-
 from .runtimes import register_pip_runtimes
-
-try:
-    __version__ = _metadata.version("cltess")
-except _metadata.PackageNotFoundError:  # run from a source tree that was never installed
-    __version__ = "0+unknown"
 
 # Before anything lists OpenCL platforms: let the ICD loader see pip-installed CPU runtimes.
 register_pip_runtimes()
@@ -22,8 +15,22 @@ from .scene import Camera, Scene, SceneError  # noqa: E402
 from .tessellation import Tessellation  # noqa: E402
 
 
+def _version() -> str:
+    from importlib import metadata
+
+    try:
+        return metadata.version("cltess")
+    except metadata.PackageNotFoundError:  # run from a source tree that was never installed
+        return "0+unknown"
+
+
 def __getattr__(name):
-    # Lazy: importing cltess must not need an OpenCL platform.
+    # Lazy: importing cltess must not need an OpenCL platform.  __version__: reading the
+    # package's metadata (an email parse) is left to whoever asks.
+    if name == "__version__":
+        global __version__
+        __version__ = _version()
+        return __version__
     if name == "Tessellator":
         from .backends.opencl import Tessellator
         return Tessellator

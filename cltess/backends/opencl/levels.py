@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pyopencl.array as cl_array
-from pyopencl.scan import GenericScanKernel
+from .scan_kernel import GenericScanKernel
 
 from ...kinds import KINDS
 from ...patterns.semi_uniform import interior_template, point_template

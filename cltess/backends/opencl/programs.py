@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import pyopencl as cl
 import pyopencl._cl as _cl
-from pyopencl.scan import GenericScanKernel
+from .scan_kernel import GenericScanKernel
 from pyopencl.tools import get_or_register_dtype, match_dtype_to_c_struct
 
 from ...device import BuildError, first_error_line
