@@ -98,7 +98,8 @@ def finish(started: Started) -> Run:
     if started.process is not None:
         started.process.wait()
     returncode_file = started.out_dir / "returncode"
-    while not returncode_file.exists():  # a pass that another process started
+    give_up = time.monotonic() + TIMEOUT_S + 60  # (its wrapper ends it after TIMEOUT_S)
+    while not returncode_file.exists() and time.monotonic() < give_up:  # a pass another process started
         time.sleep(1)
     stdout = (started.out_dir / "stdout.txt").read_text(errors="replace")
     stderr = (started.out_dir / "stderr.txt").read_text(errors="replace")
@@ -107,7 +108,7 @@ def finish(started: Started) -> Run:
         record = json.loads(line)
         if "name" in record:
             results[record["name"]] = record
-    returncode = int(returncode_file.read_text())
+    returncode = int(returncode_file.read_text()) if returncode_file.exists() else -9
     return Run(returncode, results, scenarios.parse_stderr(stderr), stderr, started.out_dir)
 
 
