@@ -30,11 +30,10 @@ from dataclasses import dataclass
 
 import numpy as np
 import pyopencl.array as cl_array
-from .scan_kernel import GenericScanKernel
 
-from ...kinds import KINDS
 from ...patterns.semi_uniform import interior_template, point_template
 from ...tessellation import Tessellation
+from .scan_kernel import GenericScanKernel
 from .tessellator import WORK_GROUP, Plan, Tessellator, _span_ms
 
 #: m = log2 of the patch's largest factor (its records are 2^p_e; a collapsed edge's stored
