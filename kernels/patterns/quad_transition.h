@@ -100,23 +100,19 @@ inline uint uniform_grid_index(pattern_grid g, int2 point)
     return (uint)(2 * a + 2 * b) + (uint)(j - 1) * (uint)(a - 1) + (uint)(i - 1);
 }
 
+/* pattern_grid_index, by uniform_grid_index where the grid is uniform. */
+inline uint grid_point_index(pattern_grid g, int2 point)
+{
+    return g.uniform ? uniform_grid_index(g, point) : pattern_grid_index(g, point);
+}
+
 /* Cell (i, j) of the grid, two triangles (a, b, c), (a, c, d) with a = (i, j), b = (i + 1, j),
  * c = (i + 1, j + 1), d = (i, j + 1); a triangle with a side on a collapsed edge (bit e of
  * collapsed) joins two coincident points and is left out. */
 inline void grid_cell(__global uint *out, uint *count, uint base, pattern_grid g, int collapsed, int i, int j)
 {
-    uint a, b, c, d;
-    if (g.uniform) {
-        a = uniform_grid_index(g, (int2)(i, j));
-        b = uniform_grid_index(g, (int2)(i + 1, j));
-        c = uniform_grid_index(g, (int2)(i + 1, j + 1));
-        d = uniform_grid_index(g, (int2)(i, j + 1));
-    } else {
-        a = pattern_grid_index(g, (int2)(i, j));
-        b = pattern_grid_index(g, (int2)(i + 1, j));
-        c = pattern_grid_index(g, (int2)(i + 1, j + 1));
-        d = pattern_grid_index(g, (int2)(i, j + 1));
-    }
+    uint a = grid_point_index(g, (int2)(i, j)), b = grid_point_index(g, (int2)(i + 1, j));
+    uint c = grid_point_index(g, (int2)(i + 1, j + 1)), d = grid_point_index(g, (int2)(i, j + 1));
     if (!((j == 0 && (collapsed & 1)) || (i + 1 == g.core.x && (collapsed & 2))))
         put_triangle(out, count, base, a, b, c);
     if (!((j + 1 == g.core.y && (collapsed & 4)) || (i == 0 && (collapsed & 8))))

@@ -19,10 +19,10 @@ from pathlib import Path
 import numpy as np
 import pyopencl as cl
 import pyopencl._cl as _cl
-from .scan_kernel import GenericScanKernel
 from pyopencl.tools import get_or_register_dtype, match_dtype_to_c_struct
 
 from ...device import BuildError, first_error_line
+from .scan_kernel import GenericScanKernel
 
 STAGES = ("factors", "crack_free", "counts", "vertices", "indices")
 #: What each stage's program is composed of: the headers it includes, in this order.
