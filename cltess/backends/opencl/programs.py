@@ -9,6 +9,7 @@ headers fulfil is in docs/extending.md.
 """
 from __future__ import annotations
 
+import math
 import os
 import shlex
 from dataclasses import dataclass
@@ -98,6 +99,26 @@ def changed_arguments(args: tuple, kept: tuple | None) -> tuple | None:
     return changed
 
 
+#: Work-items per work-group where a launch names the size: the kernels that stage through
+#: local memory, and every launch on PoCL (``named_local_size``).  Global sizes are whole
+#: multiples of it (tessellator._global_size).
+WORK_GROUP = 64
+
+
+def names_local_size(device: cl.Device) -> bool:
+    """Whether launches on ``device`` name their work-group size where the caller leaves it to the
+    runtime.  PoCL compiles a kernel once per work-group size and, left to choose, picks the size
+    from the global size, so each scene of a new size cost about 2.6 CPU-s of compiling on a cold
+    kernel cache (bench/RESULTS.md "Session 9, lead: one work-group size on PoCL").  Intel's CPU
+    runtime and NVIDIA's compile once and are left to choose."""
+    return device.platform.name.strip() == "Portable Computing Language"
+
+
+def named_local_size(global_size: tuple) -> tuple:
+    """WORK_GROUP, or the largest size that divides the global one (OpenCL 1.2 wants whole groups)."""
+    return (math.gcd(global_size[0], WORK_GROUP), *(1 for _ in global_size[1:]))
+
+
 def same_arguments(args: tuple, kept: tuple | None) -> bool:
     """Whether a launch's arguments are those kept from the last one (``changed_arguments``)."""
     return changed_arguments(args, kept) == ()
@@ -155,6 +176,8 @@ class Kernel:
     def launch(self, queue, global_size, local_size, args: tuple, options: dict | None = None) -> cl.Event:
         """``__call__`` with the arguments as a tuple: the kept tuple itself (a recorded launch
         enqueued again, ``Launch.again``) is known to be set without comparing them."""
+        if local_size is None and self.programs is not None and self.programs.names_local_size:
+            local_size = named_local_size(global_size)
         kept = self.kept
         changed = None if options or kept is None else () if args is kept else changed_arguments(args, kept)
         keep = self.programs is not None and self.programs.keep_arguments and not options
@@ -255,6 +278,8 @@ class Programs:
 
     def __init__(self, context: cl.Context):
         self.context = context
+        #: Whether launches name their work-group size (``names_local_size``).
+        self.names_local_size = names_local_size(context.devices[0])
         self._programs: dict = {}
         self._kernels: dict = {}
         self._seen: dict = {}  # Programs.kernel's look-up by the identity of its arguments

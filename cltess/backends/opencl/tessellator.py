@@ -41,10 +41,9 @@ from ...request import Request
 from ...scene import Scene
 from ...tessellation import BYTES_PER_INDEX, BYTES_PER_VERTEX, VERTEX_RECORD, DeviceOutput, Tessellation
 from .level_functions import build_level_function_programs, level_factors
-from .programs import Programs
+from .programs import WORK_GROUP, Programs
 from .strips import build_strip_programs, emit_strips, strip_offsets, strip_parts
 
-WORK_GROUP = 64  # global sizes are rounded up to this; kernels guard their index
 #: stages/vertex_rows.cl: work-items per patch (the ring and 64 rows; a patch with more rows has
 #: its last work-item do the rest, so this is a speed setting, never a limit).
 MAX_ROWS_PER_PATCH = 65
