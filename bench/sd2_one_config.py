@@ -31,7 +31,6 @@ this layout (records and surfaces the same), side by side.
 from __future__ import annotations
 
 import argparse
-import itertools
 import sys
 import time
 from pathlib import Path
@@ -44,7 +43,7 @@ sys.path.insert(0, str(REPO / "bench"))
 sys.path.insert(0, str(REPO / "tests"))
 
 import cltess.patterns.sd2 as sd2  # noqa: E402
-from cltess.patterns.fractional import FIXED_ONE, locations, odd_segments, to_fixed  # noqa: E402
+from cltess.patterns.fractional import FIXED_ONE, locations, to_fixed  # noqa: E402
 
 MAIN_PATTERN, MAIN_CHORDS = sd2.sd2_pattern, sd2.sd2_chords
 
@@ -85,9 +84,17 @@ def one_config_layout(f) -> tuple[np.ndarray, list]:
     if lay.shape == "grid":
         lay.tip = 0  # C: rows from corner 0, corner 1's weight at the edges' points
         n, t = lay.n[0], locations(lay.f[0]).astype(np.float64)
+        sigma, g = (odd_weight(lay.f[0], PRODUCT_REACH), sd2.sd2_grid_corner(f)) if PRODUCT_REACH > 0 else (0.0, 0)
         for i in range(2, n):
             for j in range(1, i):
-                uv.append(np.array([1.0 - t[i], t[i - j]]))
+                label = (n - i, i - j, j)  # corners 0, 1, 2: rows from corner 0
+                point = configuration_point(t, label)
+                if sigma > 0:  # near odd factors: towards main's hinted grid (the tie of g, g+1)
+                    main = np.zeros(3)
+                    main[g], main[(g + 1) % 3] = t[label[g]], t[label[(g + 1) % 3]]
+                    main[(g + 2) % 3] = 1 - main[g] - main[(g + 1) % 3]
+                    point = sigma * main + (1 - sigma) * point
+                uv.append(point[:2])
         for i in range(n):
             strip = []
             for j in range(i + 1, 0, -1):
@@ -107,7 +114,20 @@ def one_config_layout(f) -> tuple[np.ndarray, list]:
                 radial[c], radial[(c + 1) % 3], radial[(c + 2) % 3] = 1 - t[i], t[i] * (1 - s[j]), t[i] * s[j]
                 point = radial
                 if w is not None:
-                    point = w * radial + (1 - w) * configuration_point(x_base, native_label(c, b, rows[i], j))
+                    target = configuration_point(x_base, native_label(c, b, rows[i], j))
+                    if BIRTH_BLEND:  # C on the ties, the product (partner c+1) where rows or columns are born
+                        beta = birth_weight(lay.f[c], lay.f[(c + 1) % 3], a, b)
+                        product = np.zeros(3)
+                        product[c], product[(c + 2) % 3] = 1 - t[i], max(t[i] + s[j] - 1, 0.0)
+                        product[(c + 1) % 3] = 1 - product[c] - product[(c + 2) % 3]
+                        target = beta * target + (1 - beta) * product
+                    elif PRODUCT_REACH > 0:  # near odd G: towards the tie configuration with partner c+1
+                        sigma = odd_weight(lay.f[(c + 1) % 3], PRODUCT_REACH)
+                        product = np.zeros(3)
+                        product[c], product[(c + 2) % 3] = 1 - t[i], max(t[i] + s[j] - 1, 0.0)
+                        product[(c + 1) % 3] = 1 - product[c] - product[(c + 2) % 3]
+                        target = sigma * product + (1 - sigma) * target
+                    point = w * radial + (1 - w) * target
                 uv.append(point[:2])
         for j in range(b):
             strip = [lay.sd2(0, 0)]
@@ -131,14 +151,95 @@ def one_config_pattern(f) -> tuple[np.ndarray, np.ndarray]:
     return uv, np.array(triangles, np.int64).reshape(-1, 3)
 
 
+#: the hybrid's reach (factor units): main's zone at an odd whole base factor G (births), the one
+#: configuration FAR_ODD or more from every odd number, a linear blend between
+FAR_ODD = 0.125
+#: variant "product": within PRODUCT_REACH of an odd G the zone's target moves from C towards the
+#: tie configuration with partner c+1 (main's lam = 1: a product in the fan's own indices,
+#: continuous at births for every tip); 0: off
+PRODUCT_REACH = 0.0
+
+
+#: variant "birth": the zone's target C on the tie line F = G and the product (main's lam = 1 target,
+#: continuous where rows or columns are born, for every tip) on the birth lines (F at the odd n above,
+#: G at the odd n - 2 below), by birth_weight
+BIRTH_BLEND = False
+
+
+def birth_weight(big: int, base: int, a: int, b: int) -> float:
+    """beta: 1 on the tie line F = G, 0 where F reaches the odd a (rows are born past it) or G the odd
+    a - 2 (columns were born there), and 0 where a = b + 2 (between the two births): in the bracket
+    (a - 2, a], ``min((G - (a - 2)) / (F - (a - 2)), (a - F) / (a - G))``.  Continuous except at the
+    ties at odd whole factors, approached from above."""
+    if a != b:
+        return 0.0
+    if big == base:
+        return 1.0
+    big, base = big / FIXED_ONE, base / FIXED_ONE
+    return min((base - (a - 2)) / (big - (a - 2)), (a - big) / (a - base))
+
+
+def odd_weight(fixed: int, reach: float | None = None) -> float:
+    """sigma: 1 at an odd whole factor, 0 from `reach` (FAR_ODD) on, linear between."""
+    reach = FAR_ODD if reach is None else reach
+    return float(np.clip(1.0 - sd2.odd_distance(int(fixed)) / FIXED_ONE / reach, 0.0, 1.0))
+
+
+def hybrid_layout(f) -> tuple[np.ndarray, list, tuple]:
+    """(uv, triangles, chords) of the hybrid: main's layout and vertex numbering, every vertex at
+    sigma main + (1 - sigma) one-configuration (sigma = odd_weight of the base's factor, the grid's
+    factor for a grid), the zone's centres on their chords at sigma mu (the one configuration puts
+    them on (i, j+1): the fan's own diagonal, bench/sd2_tie_limits.py (A))."""
+    uv, triangles = MAIN_PATTERN(f)
+    chords = MAIN_CHORDS(f)
+    lay = sd2._Layout(f)
+    if lay.shape == "sd2":
+        sigma = odd_weight(lay.f[(lay.tip + 1) % 3])
+        one_uv, _ = one_config_layout(f)
+        k = len(one_uv)
+        uv = uv.copy()
+        uv[:k] = sigma * uv[:k] + (1 - sigma) * one_uv
+        if len(chords[0]):
+            vertices, start, end, mu = chords
+            mu = (sigma * mu.astype(np.float64)).astype(np.float32)
+            uv[vertices] = (1 - mu[:, None]) * uv[start] + mu[:, None] * uv[end]
+            chords = (vertices, start, end, mu)
+    elif lay.shape == "grid" and sd2.sd2_hint(f) is not None:
+        sigma = odd_weight(lay.f[0])
+        n, g, x = lay.n[0], lay.tip, locations(lay.f[0]).astype(np.float64)
+        uv = uv.copy()
+        for i in range(2, n):
+            for j in range(1, i):
+                label = [0, 0, 0]
+                label[g], label[(g + 1) % 3], label[(g + 2) % 3] = n - i, i - j, j
+                uv[lay.grid(i, j)] = sigma * uv[lay.grid(i, j)] + (1 - sigma) * configuration_point(x, label)[:2]
+    return uv, triangles, chords
+
+
+def hybrid_pattern(f):
+    uv, triangles, _ = hybrid_layout(f)
+    return uv, triangles
+
+
+def hybrid_chords(f):
+    return hybrid_layout(f)[2]
+
+
 def no_chords(f):
     return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0, np.float32)
 
 
 def use(variant: str) -> None:
-    """Point the mirror (and the modules that imported its names) at main's pattern or this one."""
+    """Point the mirror (and the modules that imported its names) at main's pattern or a variant:
+    "one", "hybrid" (main near odd base factors, FAR_ODD), "product-R" (the one configuration
+    with PRODUCT_REACH = R), "birth" (BIRTH_BLEND)."""
     import test_sd2_pattern as model
-    pattern, chords = (MAIN_PATTERN, MAIN_CHORDS) if variant == "main" else (one_config_pattern, no_chords)
+    global PRODUCT_REACH, BIRTH_BLEND
+    PRODUCT_REACH = float(variant.split("-")[1]) if variant.startswith("product-") else 0.0
+    BIRTH_BLEND = variant == "birth"
+    variant = "one" if variant.startswith("product-") or variant == "birth" else variant
+    pattern, chords = {"main": (MAIN_PATTERN, MAIN_CHORDS), "one": (one_config_pattern, no_chords),
+                       "hybrid": (hybrid_pattern, hybrid_chords)}[variant]
     sd2.sd2_pattern, sd2.sd2_chords, model.sd2_pattern = pattern, chords, pattern
     object.__setattr__(sd2.SD2, "layout", pattern)  # a frozen dataclass
     object.__setattr__(sd2.SD2, "chords", chords)
