@@ -21,12 +21,18 @@ whichever corners tie, triple ties included.  Where G crosses the odd m with a =
 target jumps for tips whose corner c+2 is 0 or 1 (the fifth pass's (B): the third index is no
 product); measured here, not removed.
 
-    python bench/sd2_one_config.py folds            # fold-over: exhaustive (F, G) grid, 3 tips
-    python bench/sd2_one_config.py model            # model surface: loops, passing paths, births
-    python bench/sd2_one_config.py orbit --mesh sphere-320 --sweep 20 --steps 10 [sd2_pops options]
+Variants (``use``): ``main`` (today's mirror), ``one`` (the above), ``hybrid`` (main's layout where
+G is an odd whole number, the one configuration from FAR_ODD away, a linear blend between),
+``birth`` (the target blended from C on the tie line to the product P, main's lam = 1 target, on the
+birth lines: birth_weight), ``product-R`` (towards P within R of an odd G).
 
-``orbit`` runs bench/sd2_pops.py's measure on the NumPy backend twice, with main's mirror and with
-this layout (records and surfaces the same), side by side.
+    python bench/sd2_one_config.py folds            # fold-over: exhaustive (F, G) grid, 3 tips
+    python bench/sd2_one_config.py model [--variants main one birth hybrid]   # model surface
+    python bench/sd2_one_config.py orbit --mesh sphere-320 --sweep 20 --steps 10 [sd2_pops options]
+                                         [--variants main one] [--top 3]
+
+``orbit`` runs bench/sd2_pops.py's measure (vertices) on the NumPy backend once per variant (records
+and surfaces the same; main's row reproduces the OpenCL tables of bench/RESULTS.md), side by side.
 """
 from __future__ import annotations
 
@@ -250,7 +256,7 @@ def signed_areas(uv, triangles):
     return 0.5 * ((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
 
 
-def fold_scan(top: float = 9.0, step: int = FIXED_ONE // 64, base_step: int = FIXED_ONE // 64):
+def fold_scan(top: float = 11.0, step: int = FIXED_ONE // 32, base_step: int = FIXED_ONE // 32):
     """Smallest signed area of the one-configuration zone over F in [1, top] (step 16.16 units),
     G in (F - 1, F] (base_step), the three tips; and the area sum (1/2)."""
     worst, where, area_error = np.inf, None, 0.0
@@ -277,7 +283,7 @@ def main(argv=None) -> int:
         print(f"smallest signed area {worst:.3g} at (F, G, tip) = {where}; area sum off 1/2 by {area_error:.2g} "
               f"({time.process_time() - started:.0f} s CPU)")
     elif args.part == "model":
-        model_part()
+        model_part(orbit_arguments(rest).variants)
     else:
         orbit_part(rest)
     return 0
@@ -309,9 +315,9 @@ def births(odd=(3, 5, 7), gaps=(0.2, 0.6), unit=1e-4):
                   + " / ".join(f"{x:.3f}" for x in worst) + " of the factor-1 error", flush=True)
 
 
-def model_part():
+def model_part(variants):
     import sd2_zone_model as zone
-    for variant in ("main", "one"):
+    for variant in variants:
         use(variant)
         print(f"== {variant}", flush=True)
         births()
