@@ -61,9 +61,9 @@ def native_label(c: int, n: int, i: int, j: int) -> tuple:
     return tuple(idx)
 
 
-def merged_rows(fixed: int, m: int) -> np.ndarray:
-    """k' of each point of an edge of factor fixed (n = m + 2, just past the odd m): the m-lattice
-    index its location tends to as the factor falls to m (rint(X(m+) m))."""
+def merged_rows(m: int) -> np.ndarray:
+    """k' of each point of an edge with m + 2 segments (its factor past the odd m): the m-lattice
+    index its location tends to as the factor falls to m (rint(X(m+) m), one 16.16 unit past m)."""
     x = locations(int(to_fixed(m)) + 1).astype(np.float64)
     return np.rint(x * m).astype(int)
 
@@ -113,7 +113,7 @@ def one_config_layout(f) -> tuple[np.ndarray, list]:
         t, s = locations(lay.f[c]).astype(np.float64), locations(lay.f[(c + 1) % 3]).astype(np.float64)
         w = zone_weight(lay.f, c)
         x_base = s  # C_G: the lattice of the base's factor
-        rows = np.arange(a + 1) if a == b else merged_rows(lay.f[c], b)
+        rows = np.arange(a + 1) if a == b else merged_rows(b)
         for i in range(1, a):
             for j in range(1, b):
                 radial = np.zeros(3)
