@@ -1,0 +1,94 @@
+"""The tie zone with one grid configuration for every fan (bench/sd2_one_config.py; docs/sd2.md
+section 5, "Ninth pass"), a NumPy experiment not built into the pattern: no fold-over over the
+zone's (F, G) by hypothesis, every fan reaching the grid's configuration at a tie whichever corners
+tie, a path past an isolated triple tie moving the mesh in proportion, and the birth obstruction
+(the fifth pass's (B)) as measured: the base's factor crossing an odd number inside the zone
+jumps for the tips whose corner c+2 is one of the configuration's pair."""
+import importlib.util
+import sys
+from pathlib import Path
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from cltess.patterns.fractional import FIXED_ONE, odd_segments
+from test_sd2_pattern import hinted_record, lifted_distance, plateau_error, same_surface, signed_areas
+
+
+def _load_bench():
+    path = Path(__file__).resolve().parents[1] / "bench" / "sd2_one_config.py"
+    spec = importlib.util.spec_from_file_location("bench_sd2_one_config", path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+one_config = _load_bench()
+
+
+def fan(c: int, big: int, base: int) -> list:
+    f = [0, 0, 0]
+    f[c], f[(c + 2) % 3], f[(c + 1) % 3] = big, big, base
+    return f
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(FIXED_ONE + 1, 13 * FIXED_ONE), st.integers(1, FIXED_ONE - 1), st.integers(0, 2))
+def test_the_one_configuration_zone_does_not_fold(big, gap, c):
+    f = fan(c, big, max(big - gap, FIXED_ONE))  # a fan (F > G) in the zone
+    uv, triangles = one_config.one_config_pattern(f)
+    areas = signed_areas(uv, triangles)
+    # zero-area triangles where the configuration collapses points: float32 edge locations give
+    # them areas of a few 1e-9 either side (as tests/test_sd2_pattern.py's tie zone, tolerance 1e-7)
+    assert areas.min() >= -1e-7, (f, areas.min())
+    assert abs(areas.sum() - 0.5) < 1e-7, f  # float32 edge locations
+    a, b = odd_segments(f[c]), odd_segments(f[(c + 1) % 3])
+    assert len(uv) == len(np.unique(triangles)) == a * (b + 1) + 1 and len(triangles) == b * (2 * a - 1), f
+
+
+def test_every_fan_reaches_the_grid_configuration_at_a_tie():
+    one_config.use("one")
+    try:
+        for h in (1.7, 2.0, 2.86, 4.4, 6.3, 8.9):
+            grid = [round(h * FIXED_ONE)] * 3
+            for c in range(3):
+                assert same_surface(fan(c, grid[0] + 1, grid[0]), grid) < 1e-4, (h, c)
+    finally:
+        one_config.use("main")
+
+
+def passing_worst(step: float) -> float:
+    """A path passing within about 0.01 of a triple tie at 2.86 (sphere-320 depth's worst patches;
+    bench/sd2_zone_model.py passing): the worst step, in factor-1 errors."""
+    def at(x):
+        return hinted_record([round(v * FIXED_ONE) for v in (2.96 - x, 2.85 + 0.15 * (0.1 - x), 2.82 + 0.5 * x)])
+    xs = np.arange(0.0, 0.2 + 1e-9, step)
+    return max(lifted_distance(at(x), at(y)) for x, y in zip(xs[:-1], xs[1:])) / plateau_error(1)
+
+
+def test_passing_an_isolated_triple_tie_moves_in_proportion_with_one_configuration():
+    one_config.use("one")
+    try:
+        coarse, fine = passing_worst(0.02), passing_worst(0.01)
+    finally:
+        one_config.use("main")
+    assert coarse < 0.03 and fine < 0.7 * coarse, (coarse, fine)  # main: 0.226 / 0.225
+
+
+def test_the_base_crossing_an_odd_number_in_the_zone_jumps_for_two_tips():
+    """G crossing 3 with F = 3.4 (w about 0.4): tip 0 (its corners c, c+1 the configuration's pair)
+    is continuous, tips 1 and 2 jump by about the factor-3 error (main's zone: continuous)."""
+    one_config.use("one")
+    try:
+        jumps = []
+        for c in range(3):
+            def record(s):
+                phi = [0.0, 0.0, 0.0]
+                phi[c], phi[(c + 1) % 3], phi[(c + 2) % 3] = 3.4, 2.7, 3.0 + s
+                return hinted_record([round(x * FIXED_ONE) for x in phi])
+            jumps.append(lifted_distance(record(-1e-4), record(1e-4)) / plateau_error(3))
+    finally:
+        one_config.use("main")
+    assert jumps[0] < 0.01 and min(jumps[1:]) > 0.3, jumps
