@@ -62,9 +62,10 @@ class Started:
 
 def pass_names(name: str) -> list[str]:
     """What a pass runs: every scenario (the uninitialised-value pass leaves out the ones it
-    skips, UNINITIALIZED_SKIPPED, to save their simulation time) and the pass's self-tests."""
-    skipped = scenarios.UNINITIALIZED_SKIPPED if name == "uninitialized" else {}
-    return [*(n for n in NAMES if n not in skipped), *PASSES[name]["selftests"]]
+    skips, UNINITIALIZED_SKIPPED, to save their simulation time, and those another scenario
+    covers, UNINITIALIZED_COVERED_BY) and the pass's self-tests."""
+    left = {**scenarios.UNINITIALIZED_SKIPPED, **scenarios.UNINITIALIZED_COVERED_BY} if name == "uninitialized" else {}
+    return [*(n for n in NAMES if n not in left), *PASSES[name]["selftests"]]
 
 
 def start(name: str, out_dir: Path, names: list[str] | None = None) -> Started:
