@@ -175,7 +175,8 @@ class Kernel:
 
     def launch(self, queue, global_size, local_size, args: tuple, options: dict | None = None) -> cl.Event:
         """``__call__`` with the arguments as a tuple: the kept tuple itself (a recorded launch
-        enqueued again, ``Launch.again``) is known to be set without comparing them."""
+        enqueued again, ``Launch.again``) is known to be set without comparing them.  A local size
+        left as None is named here where the runtime compiles per size (``names_local_size``)."""
         if local_size is None and self.programs is not None and self.programs.names_local_size:
             local_size = named_local_size(global_size)
         kept = self.kept
