@@ -80,20 +80,6 @@ inline void step_differences(float4 d[4])
     d[2] += d[3];
 }
 
-/* --- exact quotients ------------------------------------------------------------------------- */
-
-/* (float)k / (float)n, n > 0, without the division where n is a power of two 2^m, and bitwise the
- * same: dividing a float by 2^m scales it exactly unless the quotient is subnormal, and here
- * |(float)k| is 0 or >= 1 and m <= 30, so the correctly rounded quotient is (float)k 2^-m, the
- * product by the float of exponent field 127 - m (one exact multiplication).  A domain point
- * k / f of a power-of-two factor (uniform levels 2^n) then costs no division; other n divide. */
-inline float int_quotient(int k, int n)
-{
-    if (n > 0 && (n & (n - 1)) == 0)
-        return (float)k * as_float((127 - (31 - (int)clz(n))) << 23);
-    return (float)k / (float)n;
-}
-
 /* --- boundary points (docs/design.md section 4) ---------------------------------------------- */
 
 /* Point k of f on an edge: the pattern says which (pattern_ring_param), the kind places it
@@ -142,14 +128,14 @@ inline float edge_near_fraction(edge_param t, int *from_end)
 {
     int near = min(t.k, t.f - t.k);
     *from_end = near != t.k;
-    return t.fixed ? fractional_location(t.fixed, near) : int_quotient(near, t.f);
+    return t.fixed ? fractional_location(t.fixed, near) : (float)near / (float)t.f;
 }
 
 /* The location of point t along its edge, from its start, in [0, 1]. */
 inline float edge_location(edge_param t)
 {
     if (!t.fixed)
-        return int_quotient(t.k, t.f);
+        return (float)t.k / (float)t.f;
     int from_end;
     float near = edge_near_fraction(t, &from_end);
     return from_end ? 1.0f - near : near;

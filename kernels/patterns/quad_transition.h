@@ -47,7 +47,7 @@ inline float3 pattern_row_point(int4 f, int j, int i)
 {
     int uniform;
     int2 core = quad_core(f, &uniform);
-    return (float3)(int_quotient(i, core.x), int_quotient(j, core.y), 0.0f);  /* i / A, j / B */
+    return (float3)((float)i / (float)core.x, (float)j / (float)core.y, 0.0f);
 }
 
 #include "patterns/layout.h"

@@ -1,20 +1,13 @@
-"""Stage 4's exact shortcuts against NumPy's float32 division, bit for bit, on random input:
-``int_quotient`` (kernels/common.h: k / n by one exact multiplication where n is a power of two)
-and ``projected`` (kernels/kinds/bezier.h: h.xyz / h.w with no division where h.w is exactly 1).
-Both must give the correctly rounded quotient's bits, signed zeros and infinities included, which
-is what NumPy's IEEE division gives."""
+"""Stage 4's exact shortcut against NumPy's float32 division, bit for bit, on random input:
+``projected`` (kernels/kinds/bezier.h: h.xyz / h.w with no division where h.w is exactly 1) must
+give the correctly rounded quotient's bits, signed zeros and infinities included, which is what
+NumPy's IEEE division gives."""
 import numpy as np
 import pyopencl as cl
 
 from cltess.backends.opencl.programs import correctly_rounded_division, kernel_dir
 
 KERNEL = """
-__kernel void quotients(__global const int *k, __global const int *n, __global float *out)
-{
-    int id = get_global_id(0);
-    out[id] = int_quotient(k[id], n[id]);
-}
-
 __kernel void points(__global const float4 *h, __global float *out)
 {
     int id = get_global_id(0);
@@ -38,20 +31,6 @@ def run(tessellator, kernel_name, inputs, out):
     getattr(program, kernel_name)(queue, (len(inputs[0]),), None, *buffers, result)
     cl.enqueue_copy(queue, out, result)
     return out
-
-
-def test_int_quotient_is_the_division(tessellator):
-    rng = np.random.default_rng(15)
-    powers = 1 << rng.integers(0, 31, 6000)
-    others = rng.integers(1, 1 << 20, 6000)
-    n = np.concatenate([powers, others, np.arange(1, 65), np.full(64, 16)]).astype(np.int32)
-    k = np.concatenate([rng.integers(-(1 << 26), 1 << 26, 6000),  # beyond 2^24: (float)k rounds first
-                        rng.integers(0, 1 << 20, 6000) % np.maximum(others, 1),
-                        np.arange(64), np.arange(-1, 63)]).astype(np.int32)
-    got = run(tessellator, "quotients", [k, n], np.empty(len(k), np.float32))
-    want = k.astype(np.float32) / n.astype(np.float32)
-    assert np.array_equal(got.view(np.uint32), want.view(np.uint32))
-    assert (n & (n - 1) == 0).sum() > 6000 and (n & (n - 1) != 0).sum() > 6000  # both paths
 
 
 def test_projected_is_the_division(tessellator):
