@@ -140,14 +140,7 @@ void prepared_rows(__global const kind_patch *restrict prepared, __global const 
     }
     barrier(CLK_LOCAL_MEM_FENCE);
     uint rows = row_first[patches], lines = rows + PATTERN_EDGES * patches;
-    uint rounds = (lines + LINE_GROUP - 1) / LINE_GROUP, group = (uint)get_group_id(0);
-    for (uint r = 0; r < rounds; ++r) {
-        /* The rounds rotated by the group (from round group % rounds on; every line still written
-         * to its own slots), so that the groups' write-outs do not all fall at the same moments:
-         * in order, the groups, all alike, computed and then stored in step, and the stores stood
-         * exposed (H100, uniform level 16: ... ms against ... ms, bench/RESULTS.md "Issue 15:
-         * exact shortcuts and rotated rounds in stage 4 (session 9, branch gpu15g)"). */
-        uint first_line = (r + group) % rounds * LINE_GROUP;
+    for (uint first_line = 0; first_line < lines; first_line += LINE_GROUP) {
         uint line = first_line + item, q = 0;
         int edge = -1, row = 0, count = 0;
         if (line < rows) {  /* row `row` of patch q */
