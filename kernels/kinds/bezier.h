@@ -63,15 +63,16 @@ inline void surface_eval(const float4 b[16], float u, float v, float4 *s, float4
 /* The point h.xyz / h.w of a homogeneous h, without the three divisions where h.w is exactly 1,
  * and bitwise the same: for x not a NaN, the exact quotient x / 1 is x, representable, so the
  * correctly rounded division returns x itself, with x's sign (-0 stays -0, an infinity stays
- * itself); programs.py builds with correctly rounded division where the device offers it, and x86
- * and NVIDIA divide correctly rounded anyway.  (A NaN gives a NaN either way, its payload perhaps
- * not; a device flushing subnormals reads a subnormal x as the zero that x / 1 would flush it to.)
+ * itself).  programs.py builds with correctly rounded division where the device offers it (NVIDIA,
+ * PoCL); where not (Oclgrind), OpenCL would allow x / 1 within 2.5 ulp, but a division by 1 there
+ * (the host's) is exact too.  (A NaN gives a NaN either way, its payload perhaps not; a device
+ * flushing subnormals reads a subnormal x as the zero that x / 1 would flush it to.)
  * h.w is exactly 1 on a polynomial patch (every weight 1, as the teapot's) at its boundary points
  * (boundary_point's lerps of weights 1: 1 + s (1 - 1) = 1), and inside where the Bernstein values
  * of u and v sum to 1 exactly, e.g. at k / 2^n (the uniform power-of-two levels; along such a row
  * the weight's forward differences are then 1, 0, 0, 0 and stay so).  A warp whose points all have
- * weight 1 skips the divisions: stage 4 of uniform level 16 on the H100, bench/RESULTS.md "Issue
- * 15: exact shortcuts in stage 4 (session 9, branch gpu15g)". */
+ * weight 1 skips the divisions: stage 4 of uniform level 16 on the H100 0.469-0.484 ms against
+ * 0.498-0.513 (bench/RESULTS.md "Issue 15: exact shortcuts in stage 4 (session 9, branch gpu15g)"). */
 inline float3 projected(float4 h)
 {
     if (h.w == 1.0f)
