@@ -128,8 +128,9 @@ inline float3 limit_normal(const float4 b[16], float u, float v, float4 s, float
     return cross(dt_u, t_v) + cross(t_u, dt_v);
 }
 
-/* Unit normal at (u, v), given B, p = B.xyz / B.w (projected), B_u, B_v there: t_u x t_v, or at a collapsed edge its limit
- * (limit_normal); if that vanishes too, a step towards the centre; else +z.
+/* Unit normal at (u, v), given B, p = B.xyz / B.w (projected), B_u, B_v there: t_u x t_v, or at
+ * a collapsed edge its limit (limit_normal); if that vanishes too, a step towards the centre; else
+ * +z.
  * ALWAYS_INLINE works around Intel's CPU OpenCL runtime (2026.22): in ESC's stage 4 (only there)
  * its vectoriser left this float3-returning call to a vector variant and read lane k's result
  * 12 bytes (a packed float3) after lane k-1's where it was written 16 bytes (a float3's size)
