@@ -169,7 +169,7 @@ __kernel void rows_soa8(__global const float4 *controls, __global const int4 *fa
                     float4 s = (float4)(LANE(sx, k), LANE(sy, k), LANE(sz, k), LANE(sw, k));
                     float4 s_u = (float4)(LANE(d[1][0][0], k), LANE(d[1][0][1], k), LANE(d[1][0][2], k), LANE(d[1][0][3], k));
                     float4 s_v = (float4)(LANE(d[2][0][0], k), LANE(d[2][0][1], k), LANE(d[2][0][2], k), LANE(d[2][0][3], k));
-                    float3 normal = surface_normal(patch.t, x.x, x.y, s, s_u, s_v);
+                    float3 normal = surface_normal(patch.t, x.x, x.y, s, projected(s), s_u, s_v);
                     LANE(ox, k) = normal.x;
                     LANE(oy, k) = normal.y;
                     LANE(oz, k) = normal.z;
@@ -230,7 +230,7 @@ inline void normal_lanes(__private const kind_patch *patch, float8 u, float8 v, 
                 float4 s = (float4)(LANE(sx, k), LANE(sy, k), LANE(sz, k), LANE(sw, k));
                 float4 s_u = (float4)(LANE(sux, k), LANE(suy, k), LANE(suz, k), LANE(suw, k));
                 float4 s_v = (float4)(LANE(svx, k), LANE(svy, k), LANE(svz, k), LANE(svw, k));
-                float3 normal = surface_normal(patch->t, LANE(u, k), LANE(v, k), s, s_u, s_v);
+                float3 normal = surface_normal(patch->t, LANE(u, k), LANE(v, k), s, projected(s), s_u, s_v);
                 LANE(*ox, k) = normal.x;
                 LANE(*oy, k) = normal.y;
                 LANE(*oz, k) = normal.z;

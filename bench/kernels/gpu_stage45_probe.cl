@@ -24,7 +24,7 @@ __kernel void grid_vertices(__global const float4 *controls, uint patches, int f
     float4 s, s_u, s_v;
     surface_eval(b, u, w, &s, &s_u, &s_v);
     int ok;
-    float3 n = tangent_cross(s, s_u, s_v, &ok);
+    float3 n = tangent_cross(s.xyz / s.w, s_u, s_v, &ok);  /* p: the division, as before projected */
     float len = length(n);
     n = len > 0.0f ? n / len : (float3)(0.0f, 0.0f, 1.0f);
     put_vertex((vertex_out){positions, normals, uv, patch_ids, object_ids}, v, s.xyz / s.w, n, (float2)(u, w),

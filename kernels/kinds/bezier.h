@@ -60,11 +60,30 @@ inline void surface_eval(const float4 b[16], float u, float v, float4 *s, float4
     *s_v = bu[0] * d[0] + bu[1] * d[1] + bu[2] * d[2] + bu[3] * d[3];
 }
 
-/* Unnormalised t_u x t_v with t = (B_d.xyz - B_d.w p) / B.w (the 1/B.w is dropped: same
- * direction).  Sets *ok when it is not (nearly) vanishing. */
-inline float3 tangent_cross(float4 s, float4 s_u, float4 s_v, int *ok)
+/* The point h.xyz / h.w of a homogeneous h, without the three divisions where h.w is exactly 1,
+ * and bitwise the same: for x not a NaN, the exact quotient x / 1 is x, representable, so the
+ * correctly rounded division returns x itself, with x's sign (-0 stays -0, an infinity stays
+ * itself).  programs.py builds with correctly rounded division where the device offers it (NVIDIA,
+ * PoCL); where not (Oclgrind), OpenCL would allow x / 1 within 2.5 ulp, but a division by 1 there
+ * (the host's) is exact too.  (A NaN gives a NaN either way, its payload perhaps not; a device
+ * flushing subnormals reads a subnormal x as the zero that x / 1 would flush it to.)
+ * h.w is exactly 1 on a polynomial patch (every weight 1, as the teapot's) at its boundary points
+ * (boundary_point's lerps of weights 1: 1 + s (1 - 1) = 1), and inside where the Bernstein values
+ * of u and v sum to 1 exactly, e.g. at k / 2^n (the uniform power-of-two levels; along such a row
+ * the weight's forward differences are then 1, 0, 0, 0 and stay so).  A warp whose points all have
+ * weight 1 skips the divisions: stage 4 of uniform level 16 on the H100 0.469-0.484 ms against
+ * 0.498-0.513 (bench/RESULTS.md "Issue 15: exact shortcuts in stage 4 (session 9, branch gpu15g)"). */
+inline float3 projected(float4 h)
 {
-    float3 p = s.xyz / s.w;
+    if (h.w == 1.0f)
+        return h.xyz;
+    return h.xyz / h.w;
+}
+
+/* Unnormalised t_u x t_v with t = (B_d.xyz - B_d.w p) / B.w (the 1/B.w is dropped: same
+ * direction), p = B.xyz / B.w (projected).  Sets *ok when it is not (nearly) vanishing. */
+inline float3 tangent_cross(float3 p, float4 s_u, float4 s_v, int *ok)
+{
     float3 t_u = s_u.xyz - s_u.w * p;
     float3 t_v = s_v.xyz - s_v.w * p;
     float3 n = cross(t_u, t_v);
@@ -96,12 +115,11 @@ inline void surface_second(const float4 b[16], float u, float v, float4 *s_uu, f
  * T = B_d.xyz - B_d.w p and D_d p = (d_u T_u + d_v T_v) / B.w (docs/design.md section 2: "the
  * next-order term").  Second derivatives, not a step inwards: the edge's own float32 noise
  * (its control points are only nearly equal once far from the origin) stays negligible. */
-inline float3 limit_normal(const float4 b[16], float u, float v, float4 s, float4 s_u, float4 s_v)
+inline float3 limit_normal(const float4 b[16], float u, float v, float4 s, float3 p, float4 s_u, float4 s_v)
 {
     float4 s_uu, s_uv, s_vv;
     surface_second(b, u, v, &s_uu, &s_uv, &s_vv);
     float d_u = 0.5f - u, d_v = 0.5f - v;
-    float3 p = s.xyz / s.w;
     float3 t_u = s_u.xyz - s_u.w * p, t_v = s_v.xyz - s_v.w * p;
     float3 dp = (d_u * t_u + d_v * t_v) / s.w;
     float4 ds_u = d_u * s_uu + d_v * s_uv, ds_v = d_u * s_uv + d_v * s_vv;
@@ -110,25 +128,27 @@ inline float3 limit_normal(const float4 b[16], float u, float v, float4 s, float
     return cross(dt_u, t_v) + cross(t_u, dt_v);
 }
 
-/* Unit normal at (u, v), given B, B_u, B_v there: t_u x t_v, or at a collapsed edge its limit
- * (limit_normal); if that vanishes too, a step towards the centre; else +z.
+/* Unit normal at (u, v), given B, p = B.xyz / B.w (projected), B_u, B_v there: t_u x t_v, or at
+ * a collapsed edge its limit (limit_normal); if that vanishes too, a step towards the centre; else
+ * +z.
  * ALWAYS_INLINE works around Intel's CPU OpenCL runtime (2026.22): in ESC's stage 4 (only there)
  * its vectoriser left this float3-returning call to a vector variant and read lane k's result
  * 12 bytes (a packed float3) after lane k-1's where it was written 16 bytes (a float3's size)
  * after: lane k got floats 3k .. 3k+2 of the padded results, so every patch but one in 8 had
  * scrambled normals (docs/esc.md, "Normals on Intel's CPU runtime";
  * tests/test_pattern_normals.py).  Returning a float4 also avoided it. */
-ALWAYS_INLINE float3 surface_normal(const float4 b[16], float u, float v, float4 s, float4 s_u, float4 s_v)
+ALWAYS_INLINE float3 surface_normal(const float4 b[16], float u, float v, float4 s, float3 p, float4 s_u,
+                                    float4 s_v)
 {
     int ok;
-    float3 n = tangent_cross(s, s_u, s_v, &ok);
+    float3 n = tangent_cross(p, s_u, s_v, &ok);
     if (!ok) {
-        float3 limit = limit_normal(b, u, v, s, s_u, s_v);
+        float3 limit = limit_normal(b, u, v, s, p, s_u, s_v);
         if (dot(limit, limit) > dot(n, n)) {
             n = limit;
         } else {
             surface_eval(b, u + NORMAL_SHIFT * (0.5f - u), v + NORMAL_SHIFT * (0.5f - v), &s, &s_u, &s_v);
-            n = tangent_cross(s, s_u, s_v, &ok);
+            n = tangent_cross(projected(s), s_u, s_v, &ok);
         }
     }
     float len = length(n);
@@ -209,8 +229,7 @@ ALWAYS_INLINE void kind_load(__global const float4 *controls, uint p, __private 
 /* Position of point t of edge e, canonical from the edge's own control points. */
 ALWAYS_INLINE float3 kind_boundary_point(__private const kind_patch *patch, int e, edge_param t)
 {
-    float4 h = boundary_point(patch->edges[e], t);
-    return h.xyz / h.w;
+    return projected(boundary_point(patch->edges[e], t));
 }
 
 /* Direct evaluation at x = (u, v, 0) (position 0: the normal only). */
@@ -218,9 +237,10 @@ ALWAYS_INLINE void kind_eval(__private const kind_patch *patch, float3 x, __priv
 {
     float4 s, s_u, s_v;
     surface_eval(patch->t, x.x, x.y, &s, &s_u, &s_v);
+    float3 p = projected(s);
     if (position)
-        *position = s.xyz / s.w + patch->centre;
-    *normal = surface_normal(patch->t, x.x, x.y, s, s_u, s_v);
+        *position = p + patch->centre;
+    *normal = surface_normal(patch->t, x.x, x.y, s, p, s_u, s_v);
 }
 
 /* Forward differencing along a row v = start.y from u = 0 to 1 in `steps` steps: B is a cubic in
@@ -249,8 +269,9 @@ ALWAYS_INLINE void kind_row_next(__private const kind_patch *patch, __private ki
     step_differences(row->s_u);
     step_differences(row->s_v);
     float4 value = row->s[0];
-    *position = value.xyz / value.w + patch->centre;
-    *normal = surface_normal(patch->t, x.x, x.y, value, row->s_u[0], row->s_v[0]);
+    float3 p = projected(value);
+    *position = p + patch->centre;
+    *normal = surface_normal(patch->t, x.x, x.y, value, p, row->s_u[0], row->s_v[0]);
 }
 
 #endif
