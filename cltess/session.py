@@ -169,6 +169,7 @@ class Session:
         tessellator = self.tessellator
         return (tessellator.work, tessellator.records_per_item, tessellator.patches_per_group,
                 tessellator.fused_offsets, tessellator.tiled_offsets, tessellator.one_scan, tessellator._cpu,
+                tessellator.fused_crack_free,
                 tessellator.auto_work(), self.output.capacity)
 
     def __repr__(self) -> str:
