@@ -1441,13 +1441,16 @@ class Plan:
         return self._pending is None or all(
             event.command_execution_status == cl.command_execution_status.COMPLETE for event in self._pending[2])
 
-    def settle(self) -> "Plan":
+    def settle(self, ready: bool = False) -> "Plan":
         """Wait for stage 3's totals and the flags (copied without waiting by plan_on) and
-        fill in num_vertices, num_indices and the counts of ``stats``."""
+        fill in num_vertices, num_indices and the counts of ``stats``.  ready: their copies
+        are known to be complete (``totals_ready``), so there is nothing to wait for (a
+        Session frame skips the runtime's wait call then)."""
         if self._pending is None:
             return self
         totals, flags, copies = self._pending
-        self.wait_ms += wait_ms(copies)
+        if not ready:
+            self.wait_ms += wait_ms(copies)
         self._pending = None
         totals = totals.tolist()  # (Python ints, in one call)
         self.num_vertices, self.num_indices = totals[0], totals[1]
