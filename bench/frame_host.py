@@ -21,7 +21,9 @@ frame records
   until the last one is finished (``frame_loop.overlapped``);
 * "host µs": the host thread's CPU time per overlapped frame less its CPU time in waits (the
   smallest of the children's medians): the frame's own host work, Python and the runtime's
-  calls, measured by CPU time so that on a CPU device the device's threads do not count.
+  calls, measured by CPU time so that on a CPU device the device's threads do not count;
+  "waits µs": in the same loops, the wall µs per frame blocked in waits (the child's shown):
+  an overlapped loop whose wall is above its host work and device time waits there.
 
 ``--as-gpu`` makes the frames a GPU makes (work "point", stage 3 in one or two launches, as
 ``bench/frame_calls.py --as-gpu``) on a CPU device: its device times mean nothing, its host
@@ -66,18 +68,20 @@ def child(args) -> dict:
         waited[0] += time.perf_counter_ns() - started
         waited_cpu[0] += time.thread_time_ns() - cpu
 
-    def overlapped_host_cpu(session, path, rounds: int = 3) -> float:
+    def overlapped_host_cpu(session, path, rounds: int = 3) -> tuple[float, float]:
         """The host thread's CPU µs per frame in a loop of overlapped frames (until the last one
         is finished), less its CPU time in waits: the frame's host work, Python and the runtime's
-        calls, whatever else runs on the machine's cores (median of ``rounds`` loops)."""
-        loops = []
+        calls, whatever else runs on the machine's cores; and the wall µs per frame blocked in
+        waits in the same loop (the last frame's finish included); medians of ``rounds`` loops."""
+        loops, waits = [], []
         for _ in range(rounds):
-            waited_cpu[0] = 0
+            waited[0] = waited_cpu[0] = 0
             cpu = time.thread_time_ns()
             frames = [session.tessellate(camera=camera, wait=False) for camera in path]
             frames[-1].finish()
             loops.append((time.thread_time_ns() - cpu - waited_cpu[0]) / len(path) / 1e3)
-        return statistics.median(loops)
+            waits.append(waited[0] / len(path) / 1e3)
+        return statistics.median(loops), statistics.median(waits)
 
     cl.wait_for_events = timed_wait
     overlaps = "wait" in inspect.signature(cltess.Session.tessellate).parameters
@@ -113,7 +117,7 @@ def child(args) -> dict:
                "resident_host_ms": statistics.median(resident_host), "held_host_ms": statistics.median(held_host)}
         if overlaps:
             row.update(fl.overlapped(session, path))
-            row["overlapped_host_cpu_us"] = overlapped_host_cpu(session, path)
+            row["overlapped_host_cpu_us"], row["overlapped_wait_us"] = overlapped_host_cpu(session, path)
         rows.append(row)
     record = {"device": device_info(tessellator.device), "rows": rows, "cltess": cltess.__file__}
     if args.grid:
@@ -167,7 +171,7 @@ def main() -> int:
     header = f"{'scene':20} {'triangles':>10}"
     for name in trees:
         header += (f" | {name + ' device':>14} {'on device':>10} {'(host)':>7} {'ratio':>6} {'host arr.':>10} {'(host)':>7}"
-                   f" {'ratio':>6} {'looped':>8} {'overlap':>8} {'ratio':>6} {'host µs':>8}")
+                   f" {'ratio':>6} {'looped':>8} {'overlap':>8} {'ratio':>6} {'host µs':>8} {'waits µs':>8}")
     print(header)
     result = {"device": device, "load": [load_before, os.getloadavg()], "command": " ".join(sys.argv), "scenes": []}
     for index, row in enumerate(runs["this"][0]["rows"]):
@@ -181,9 +185,10 @@ def main() -> int:
             if "overlapped_wall_ms" in best:
                 line += (f" {best['looped_wall_ms']:>8.3f} {best['overlapped_wall_ms']:>8.3f}"
                          f" {best['overlapped_wall_ms'] / best['overlapped_device_ms']:>5.2f}x"
-                         f" {min(run['rows'][index]['overlapped_host_cpu_us'] for run in runs[name]):>8.1f}")
+                         f" {min(run['rows'][index]['overlapped_host_cpu_us'] for run in runs[name]):>8.1f}"
+                         f" {best['overlapped_wait_us']:>8.1f}")
             else:
-                line += f" {'-':>8} {'-':>8} {'-':>6} {'-':>8}"
+                line += f" {'-':>8} {'-':>8} {'-':>6} {'-':>8} {'-':>8}"
             entry[name] = best
         print(line)
         result["scenes"].append(entry)

@@ -130,8 +130,10 @@ class Session:
         # frames behind, so no more than two frames are ever in flight), the last one if its
         # totals are there; the buffers then hold at least what those needed.
         for age, plan in enumerate(reversed(self._plans)):
-            if age == 1 or plan.totals_ready():
+            if age == 1:
                 plan.settle()
+            elif plan.totals_ready():  # (its copy is complete: no wait call)
+                plan.settle(ready=True)
             if plan.settled:
                 self.output.reserve(plan.num_vertices, plan.num_indices // 3)
         settled = [plan for plan in self._plans if plan.settled]
@@ -169,6 +171,7 @@ class Session:
         tessellator = self.tessellator
         return (tessellator.work, tessellator.records_per_item, tessellator.patches_per_group,
                 tessellator.fused_offsets, tessellator.tiled_offsets, tessellator.one_scan, tessellator._cpu,
+                tessellator.fused_crack_free,
                 tessellator.auto_work(), self.output.capacity)
 
     def __repr__(self) -> str:

@@ -504,6 +504,12 @@ FRAMES = {"many_patches_frames": ("many_patches", "patch"), "many_patches_frames
 #: kinds (two ranges, the second from the first's total), culled patches, more patches than a tile.
 FUSED_OFFSETS = {"mixed_culled_fused_offsets": "mixed_culled", "many_patches_fused_offsets": "many_patches"}
 FUSED_OFFSETS_GROUP_HERE = 16
+#: Session frames whose stage 2 runs in stage 3's first launch (stages/crack_offsets.cl,
+#: Tessellator.fused_crack_free), with work-groups of FUSED_OFFSETS_GROUP_HERE: the first frame
+#: (sized by its totals), one recorded and one replayed; two kinds (the second range's launch reads
+#: the first's final factors), culled patches, many edges per work-item.
+FUSED_CRACK_FREE = {"mixed_culled_frames_fused_crack_free": "mixed_culled",
+                    "many_patches_frames_fused_crack_free": "many_patches"}
 #: Scenarios whose stage 3 is two launches (Tessellator.tiled_offsets: stages/offsets.cl
 #: offsets_tiles per range, offsets_carries, the plan's summary from the last tile), with tiles of
 #: TILED_OFFSETS_GROUP_HERE patches: two kinds, tiles across both, culled patches counted.  (Every
@@ -630,6 +636,22 @@ def run_scenario(name: str, tessellator, out_dir: Path) -> dict:
             tess = tessellator.emit(plan, 0, plan.num_patches)
         finally:
             tessellator.fused_offsets, opencl.FUSED_OFFSETS_GROUP = saved
+    elif name in FUSED_CRACK_FREE:
+        from cltess.backends.opencl import tessellator as opencl
+        from cltess.session import Session
+
+        scene, options = SCENARIOS[FUSED_CRACK_FREE[name]]()
+        saved = tessellator.fused_offsets, tessellator.fused_crack_free, opencl.FUSED_OFFSETS_GROUP
+        tessellator.fused_offsets, tessellator.fused_crack_free = True, True
+        opencl.FUSED_OFFSETS_GROUP = FUSED_OFFSETS_GROUP_HERE
+        try:
+            session = Session(scene, tessellator=tessellator, **options)
+            for _ in range(3):  # sized by its totals, recorded, replayed
+                frame = session.tessellate()
+            assert not session._plans[-1].events["crack_free"]  # stage 2 ran in stage 3's launch
+            tess = frame.fetch()
+        finally:
+            tessellator.fused_offsets, tessellator.fused_crack_free, opencl.FUSED_OFFSETS_GROUP = saved
     elif name in TILED_OFFSETS:
         from cltess.backends.opencl import tessellator as opencl
 

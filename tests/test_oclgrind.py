@@ -243,7 +243,8 @@ def test_results_match_pocl(oclgrind, tmp_path_factory, tessellator, pass_name):
                 by_frame = load_npz(run.out_dir / f"{frame}.npz")
                 for field in ("positions", "normals", "uv", "patch_ids", "object_ids", "triangles", "factors"):
                     assert np.array_equal(getattr(by_frame, field), getattr(got, field)), f"{frame}: {field}"
-        for fused, base in {**scenarios.FUSED_OFFSETS, **scenarios.TILED_OFFSETS}.items():  # stages/offsets.cl
+        for fused, base in {**scenarios.FUSED_OFFSETS, **scenarios.TILED_OFFSETS,  # stages/offsets.cl
+                            **scenarios.FUSED_CRACK_FREE}.items():  # and crack_offsets.cl
             if base == name and fused in run.results:  # the same output, and the summary's same counts
                 by_fused = load_npz(run.out_dir / f"{fused}.npz")
                 for field in ("positions", "normals", "uv", "patch_ids", "object_ids", "triangles", "factors"):

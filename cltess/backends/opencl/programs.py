@@ -40,6 +40,7 @@ STAGE_AXES = {
     "vertex_points": ("kind", "pattern"),  # stage 4 a work-item per vertex (Tessellator(work="point"))
     "triangles": ("pattern",),  # stage 5 a work-item per triangle (Tessellator(work="point"))
     "offsets": ("pattern",),  # stage 3 in one launch (Tessellator.fused_offsets)
+    "crack_offsets": ("crack", "pattern"),  # stages 2 and 3 in one launch (Tessellator.fused_crack_free)
     "prepared_points": ("kind", "pattern"),  # stage 4 per vertex from prepared patches (work="*-prep")
     "verify": ("kind",),  # on request only (Tessellator.verify), so not in STAGES
     "integral_bound": ("integral",),  # on request only (Request(bound="integral"): integral.py)

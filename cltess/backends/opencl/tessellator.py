@@ -137,6 +137,12 @@ FUSED_OFFSETS_GROUP = 1024
 TILED_OFFSETS_MAX_PATCHES = 1 << 18
 #: Patches per tile of the two-launch stage 3 (a power of two; less where the device says so).
 TILED_OFFSETS_GROUP = 256
+#: Stages 2 and 3 in one launch (stages/crack_offsets.cl: every edge's crack-free factor, then the
+#: first range's counts and offsets, by one work-group) for a Session frame whose stage 3 is one
+#: launch, up to this many patches: a launch fewer per frame (13.7 µs of the host's time a launch on
+#: NVIDIA's runtime, bench/RESULTS.md "Session 4 on the H100"), for stage 2's 4 edges a patch on one
+#: compute unit instead of the whole device (8 edges a work-item at 1,024 work-items).
+FUSED_CRACK_FREE_MAX_PATCHES = 1 << 11
 #: A frame's summary, written by stage 3 and read back in one copy (``Tessellator.stage_counts``):
 #: vertex total, index total, patches culled, patches saturated (uint64 each).
 SUMMARY_FIELDS = 4
@@ -183,6 +189,18 @@ def default_tiled_offsets(device: cl.Device) -> bool:
     return bool(device.type & cl.device_type.GPU) and not device.type & cl.device_type.CPU
 
 
+def default_fused_crack_free(device: cl.Device) -> bool:
+    """Stage 2 in stage 3's one launch for a Session frame (``Tessellator.fuses_crack_free``):
+    ``CLTESS_FUSED_CRACK_FREE`` (0 or 1) if set, else where stage 3 is one launch by default
+    (``default_fused_offsets``)."""
+    chosen = os.environ.get("CLTESS_FUSED_CRACK_FREE")
+    if chosen not in (None, "", "0", "1"):
+        raise ValueError(f"CLTESS_FUSED_CRACK_FREE={chosen!r}: expected 0 or 1")
+    if chosen:
+        return chosen == "1"
+    return default_fused_offsets(device)
+
+
 def pure_cpu(device: cl.Device) -> bool:
     """A CPU device and nothing else (Oclgrind says "all")."""
     return bool(device.type & cl.device_type.CPU and not device.type & cl.device_type.GPU)
@@ -215,6 +233,12 @@ class PlanPart:
 
 def _pattern(kind_or_pattern) -> Pattern:
     return kind_or_pattern if isinstance(kind_or_pattern, Pattern) else kind_named(kind_or_pattern).pattern
+
+
+def crack_policy(patterns) -> str:
+    """Stage 2's crack policy header for a scene's patterns: the first other than crack/max.h
+    (ESC's crack/or_masks.h, which takes the largest factor for the other patterns' edges)."""
+    return next((pattern.crack for pattern in patterns if pattern.crack != "crack/max.h"), "crack/max.h")
 
 
 def _tolerance(eps, pixels, camera):
@@ -286,6 +310,7 @@ class Tessellator:
         self._kind_patch_sizes: dict = {}
         self._fused_groups: dict = {}  # (a stage 3 kernel, group cap) -> (work-group size, local arrays): _group_of
         self.tiled_offsets = default_tiled_offsets(self.device)  # stage 3 in two launches above the fused cap
+        self.fused_crack_free = default_fused_crack_free(self.device)  # a Session frame's stage 2 in stage 3's launch
 
     @property
     def per_item(self) -> int:
@@ -399,6 +424,10 @@ class Tessellator:
                 if self.fused_offsets:
                     self.programs.kernel("offsets", pattern=pattern)
                     self.programs.kernel("offsets", "offsets_summary", pattern=pattern)
+                if self.fused_offsets and self.fused_crack_free and scene.num_patches <= FUSED_CRACK_FREE_MAX_PATCHES:
+                    crack = crack_policy(request.pattern_for(k) for k in KINDS if k.count(scene))
+                    self.programs.kernel("crack_offsets", pattern=pattern, crack=crack)
+                    self.programs.kernel("crack_offsets", "crack_offsets_summary", pattern=pattern, crack=crack)
                 if self.tiled_offsets:
                     self.programs.kernel("offsets", "offsets_tiles", pattern=pattern)
                     self.programs.kernel("offsets", "offsets_carries", pattern=pattern)
@@ -470,17 +499,23 @@ class Tessellator:
                 events["factors"] += level_events
         if stage1_hook is not None:
             stage1_hook(factors, flags)
-        crack = next((p.pattern.crack for p in parts if p.pattern.crack != "crack/max.h"), "crack/max.h")
-        final, events["crack_free"] = self.stage_crack_free(factors, data.groups, crack, out=scratch.get("final"))
-        scratch["final"] = final
+        crack = crack_policy(part.pattern for part in parts)
         ranges = [(part.pattern, part.base, part.count) for part in parts]
+        crack_free = None
+        if defer_totals and self.fuses_crack_free(count, ranges):  # stage 2 in stage 3's first launch
+            if "final" not in scratch:
+                scratch["final"] = cl_array.empty(self.queue, factors.shape, np.int32)
+            final, events["crack_free"], crack_free = scratch["final"], [], (factors, data.groups, crack)
+        else:
+            final, events["crack_free"] = self.stage_crack_free(factors, data.groups, crack, out=scratch.get("final"))
+            scratch["final"] = final
         summary = None
         if self.writes_summary(count, ranges):  # stage 3 writes totals and flag counts: one read
             if "summary" not in scratch:
                 scratch["summary"] = cl_array.empty(self.queue, SUMMARY_FIELDS, np.uint64)
             summary = scratch["summary"]
         vertex_offsets, index_offsets, events["counts"] = self.stage_counts(
-            final, ranges, scratch=scratch, flags=flags, summary=summary)
+            final, ranges, scratch=scratch, flags=flags, summary=summary, crack_free=crack_free)
         strips = strip_offsets(self, final, parts) if strip_parts(parts) else (None, [])
         events["counts"] += strips[1]
         totals, flag_values = self._read_back_arrays(scratch if defer_totals else None, count, summary is None)
@@ -759,7 +794,8 @@ class Tessellator:
             final.data)
         return final, [event]
 
-    def stage_counts(self, factors, kind=BEZIER, scratch: dict | None = None, flags=None, summary=None):
+    def stage_counts(self, factors, kind=BEZIER, scratch: dict | None = None, flags=None, summary=None,
+                     crack_free: tuple | None = None):
         """Stage 3.  factors (P, 4) -> vertex and index offsets (P+1,) uint64, [P] = total.
 
         kind: the kind (a PatchKind or its name) or the pattern of every patch, or a list of
@@ -767,7 +803,10 @@ class Tessellator:
         count and offset arrays for the next call (``plan_on``).  summary: a (4,) uint64 device
         array that stage 3 fills with (vertex total, index total, patches culled, patches
         saturated) from stage 1's ``flags`` (P,) int32, so that the host reads one buffer
-        (``writes_summary`` says where it can: not with two scans)."""
+        (``writes_summary`` says where it can: not with two scans).  crack_free: (stage 1's
+        factors, the uploaded edge groups, the crack policy's header) to run stage 2 into
+        ``factors`` in the first range's launch (stages/crack_offsets.cl; the one-launch path
+        only: ``fuses_crack_free``)."""
         count = len(factors)
         ranges = [(kind, 0, count)] if not isinstance(kind, (list, tuple)) else kind
         scratch = {} if scratch is None else scratch
@@ -781,6 +820,8 @@ class Tessellator:
         if summary is not None and not self.writes_summary(count, ranges):
             raise ValueError("stage 3 writes a summary in one launch or with one scan (CLTESS_ONE_SCAN=1)")
         path = self._stage3_path(count, ranges)
+        if crack_free is not None and path != "fused":
+            raise ValueError("stage 2 runs in stage 3's launch only where stage 3 is one launch per range")
         if summary is not None and path == "tiled":  # two launches: tiles, then their carries
             return vertex_offsets, index_offsets, self._tiled_offsets(ranges, factors, flags, summary, scratch)
         if path == "fused":  # one launch per range, in order; the last one writes the summary
@@ -788,7 +829,7 @@ class Tessellator:
             events = [self._fused_offsets(_pattern(k), factors, base, n, vertex_counts, index_counts,
                                           vertex_offsets, index_offsets,
                                           (flags, count, summary) if summary is not None and at == len(ranges) - 1
-                                          else None)
+                                          else None, crack_free if at == 0 else None)
                       for at, (k, base, n) in enumerate(ranges)]
             return vertex_offsets, index_offsets, events
         events = [self.programs.kernel("counts", pattern=_pattern(k))(
@@ -866,16 +907,35 @@ class Tessellator:
         return count > 0 and (self.one_scan or self._stage3_path(count, ranges) != "scan")
 
     def _fused_offsets(self, pattern, factors, base, n, vertex_counts, index_counts, vertex_offsets,
-                       index_offsets, summary=None) -> cl.Event:
+                       index_offsets, summary=None, crack_free=None) -> cl.Event:
         """Stage 3 for patches base .. base+n-1 of one pattern in one work-group
         (stages/offsets.cl), from offsets[base] on; summary: (flags, their number, summary
-        array) for ``offsets_summary``."""
-        kernel = self.programs.kernel("offsets", None if summary is None else "offsets_summary", pattern=pattern)
+        array) for ``offsets_summary``; crack_free: (stage 1's factors, edge groups, crack
+        policy) to write ``factors`` first, every edge's (stages/crack_offsets.cl)."""
+        suffix = "" if summary is None else "_summary"
+        if crack_free is None:
+            kernel = self.programs.kernel("offsets", "offsets" + suffix if suffix else None, pattern=pattern)
+            stage2 = (factors.data,)
+        else:
+            raw, groups, crack = crack_free
+            kernel = self.programs.kernel("crack_offsets", "crack_offsets" + suffix if suffix else None,
+                                          pattern=pattern, crack=crack)
+            stage2 = (raw.data, groups["group_of"].data, groups["group_start"].data, groups["members"].data,
+                      groups["collapsed"].data, np.uint32(raw.size), factors.data)
         group, local_v, local_i = self._group_of(kernel, FUSED_OFFSETS_GROUP)
         extra = () if summary is None else (summary[0].data, np.uint32(summary[1]), summary[2].data)
-        return kernel(self.queue, (group,), (group,), factors.data, np.uint32(n), np.uint32(base),
+        return kernel(self.queue, (group,), (group,), *stage2, np.uint32(n), np.uint32(base),
                       vertex_counts.data, index_counts.data, vertex_offsets.data, index_offsets.data, *extra,
                       local_v, local_i)
+
+    def fuses_crack_free(self, count: int, ranges) -> bool:
+        """Whether a Session frame (``plan_on(defer_totals=True)``) of ``count`` patches in these
+        ranges runs stage 2 in stage 3's first launch (stages/crack_offsets.cl): where stage 3 is
+        one launch per range, ``fused_crack_free`` is on and the patches are at most
+        ``FUSED_CRACK_FREE_MAX_PATCHES``.  One-shot plans keep stage 2's own launch, so that
+        their ``stage_ms`` time it apart (the suite's "crack_free" column)."""
+        return (self.fused_crack_free and 0 < count <= FUSED_CRACK_FREE_MAX_PATCHES
+                and self._stage3_path(count, ranges) == "fused")
 
     def _vertex_arrays(self, n: int) -> dict:
         """The vertex record's arrays (VERTEX_RECORD, in the kernel's argument order)."""
@@ -1380,13 +1440,16 @@ class Plan:
         return self._pending is None or all(
             event.command_execution_status == cl.command_execution_status.COMPLETE for event in self._pending[2])
 
-    def settle(self) -> "Plan":
+    def settle(self, ready: bool = False) -> "Plan":
         """Wait for stage 3's totals and the flags (copied without waiting by plan_on) and
-        fill in num_vertices, num_indices and the counts of ``stats``."""
+        fill in num_vertices, num_indices and the counts of ``stats``.  ready: their copies
+        are known to be complete (``totals_ready``), so there is nothing to wait for (a
+        Session frame skips the runtime's wait call then)."""
         if self._pending is None:
             return self
         totals, flags, copies = self._pending
-        self.wait_ms += wait_ms(copies)
+        if not ready:
+            self.wait_ms += wait_ms(copies)
         self._pending = None
         totals = totals.tolist()  # (Python ints, in one call)
         self.num_vertices, self.num_indices = totals[0], totals[1]
