@@ -111,7 +111,8 @@ def names_local_size(device: cl.Device) -> bool:
     runtime.  PoCL compiles a kernel once per work-group size and, left to choose, picks the size
     from the global size, so each scene of a new size cost about 2.6 CPU-s of compiling on a cold
     kernel cache (bench/RESULTS.md "Session 9, lead: one work-group size on PoCL").  Intel's CPU
-    runtime and NVIDIA's compile once and are left to choose."""
+    runtime did not compile again for a new size (the same section); it and the others are left
+    to choose."""
     return device.platform.name.strip() == "Portable Computing Language"
 
 
