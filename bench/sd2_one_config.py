@@ -24,9 +24,10 @@ product); measured here, not removed.
 Variants (``use``): ``main`` (today's mirror), ``one`` (the above), ``hybrid`` (main's layout where
 G is an odd whole number, the one configuration from FAR_ODD away, a linear blend between),
 ``birth`` (the target blended from C on the tie line to the product P, main's lam = 1 target, on the
-birth lines: birth_weight), ``product-R`` (towards P within R of an odd G).
+birth lines: birth_weight), ``product-R`` (towards P within R of an odd G), ``follow`` (session 9, branch
+sd2j: main's layout for every record whose largest factor is at most 3, ``birth`` above; PLATEAU_TOP).
 
-    python bench/sd2_one_config.py folds            # fold-over: exhaustive (F, G) grid, 3 tips
+    python bench/sd2_one_config.py folds [--variants follow --bottom 3]   # fold-over: exhaustive (F, G), 3 tips
     python bench/sd2_one_config.py model [--variants main one birth hybrid]   # model surface
     python bench/sd2_one_config.py orbit --mesh sphere-320 --sweep 20 --steps 10 [sd2_pops options]
                                          [--variants main one] [--top 3]
@@ -172,6 +173,25 @@ PRODUCT_REACH = 0.0
 BIRTH_BLEND = False
 
 
+#: variant "follow" (session 9, branch sd2j; docs/sd2.md section 5, "Tenth pass"): today's zone (main's
+#: layout and chords: hint, lam, centres on the chord) for every record whose largest factor is at most
+#: PLATEAU_TOP (the plateau of 1 and every fan with a = 3 tip-edge segments), the birth variant above
+#: (C on the tie lines, the fan's own product on its birth lines); the two layouts are never blended
+PLATEAU_TOP = 3 * FIXED_ONE
+
+
+def at_the_plateau_of_1(f) -> bool:
+    return max(abs(int(x)) for x in f[:3]) <= PLATEAU_TOP
+
+
+def follow_pattern(f):
+    return MAIN_PATTERN(f) if at_the_plateau_of_1(f) else one_config_pattern(f)
+
+
+def follow_chords(f):
+    return MAIN_CHORDS(f) if at_the_plateau_of_1(f) else no_chords(f)
+
+
 def birth_weight(big: int, base: int, a: int, b: int) -> float:
     """beta: 1 on the tie line F = G, 0 where F reaches the odd a (rows are born past it) or G the odd
     a - 2 (columns were born there), and 0 where a = b + 2 (between the two births): in the bracket
@@ -238,14 +258,14 @@ def no_chords(f):
 def use(variant: str) -> None:
     """Point the mirror (and the modules that imported its names) at main's pattern or a variant:
     "one", "hybrid" (main near odd base factors, FAR_ODD), "product-R" (the one configuration
-    with PRODUCT_REACH = R), "birth" (BIRTH_BLEND)."""
+    with PRODUCT_REACH = R), "birth" (BIRTH_BLEND), "follow" (main up to PLATEAU_TOP, birth above)."""
     import test_sd2_pattern as model
     global PRODUCT_REACH, BIRTH_BLEND
     PRODUCT_REACH = float(variant.split("-")[1]) if variant.startswith("product-") else 0.0
-    BIRTH_BLEND = variant == "birth"
+    BIRTH_BLEND = variant in ("birth", "follow")
     variant = "one" if variant.startswith("product-") or variant == "birth" else variant
     pattern, chords = {"main": (MAIN_PATTERN, MAIN_CHORDS), "one": (one_config_pattern, no_chords),
-                       "hybrid": (hybrid_pattern, hybrid_chords)}[variant]
+                       "hybrid": (hybrid_pattern, hybrid_chords), "follow": (follow_pattern, follow_chords)}[variant]
     sd2.sd2_pattern, sd2.sd2_chords, model.sd2_pattern = pattern, chords, pattern
     object.__setattr__(sd2.SD2, "layout", pattern)  # a frozen dataclass
     object.__setattr__(sd2.SD2, "chords", chords)
@@ -256,16 +276,18 @@ def signed_areas(uv, triangles):
     return 0.5 * ((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
 
 
-def fold_scan(top: float = 11.0, step: int = FIXED_ONE // 32, base_step: int = FIXED_ONE // 32):
-    """Smallest signed area of the one-configuration zone over F in [1, top] (step 16.16 units),
-    G in (F - 1, F] (base_step), the three tips; and the area sum (1/2)."""
+def fold_scan(top: float = 11.0, step: int = FIXED_ONE // 32, base_step: int = FIXED_ONE // 32,
+              bottom: float = 1.0):
+    """Smallest signed area of the variant's zone (the mirror's pattern as `use` set it) over F in
+    [bottom, top] (step 16.16 units), G in (F - 1, F] (base_step), the three tips; and the area sum
+    (1/2)."""
     worst, where, area_error = np.inf, None, 0.0
-    for big in range(FIXED_ONE, int(top * FIXED_ONE) + 1, step):
+    for big in range(int(bottom * FIXED_ONE), int(top * FIXED_ONE) + 1, step):
         for base in range(big, max(big - FIXED_ONE, FIXED_ONE - 1), -base_step):
             for c in range(3):
                 f = [0, 0, 0]
                 f[c], f[(c + 2) % 3], f[(c + 1) % 3] = big, big, base
-                uv, tri = one_config_pattern(f)
+                uv, tri = sd2.sd2_pattern(f)
                 areas = signed_areas(uv, tri)
                 area_error = max(area_error, abs(areas.sum() - 0.5))
                 if areas.min() < worst:
@@ -278,8 +300,10 @@ def main(argv=None) -> int:
     parser.add_argument("part", choices=("folds", "model", "orbit"))
     args, rest = parser.parse_known_args(argv)
     if args.part == "folds":
+        options = orbit_arguments(rest)
+        use(options.variants[-1])  # one by default; --variants follow --bottom 3: its layout above 3
         started = time.process_time()
-        worst, where, area_error = fold_scan()
+        worst, where, area_error = fold_scan(bottom=options.bottom)
         print(f"smallest signed area {worst:.3g} at (F, G, tip) = {where}; area sum off 1/2 by {area_error:.2g} "
               f"({time.process_time() - started:.0f} s CPU)")
     elif args.part == "model":
@@ -355,6 +379,7 @@ def orbit_arguments(argv):
     parser.add_argument("--high", type=float, default=6.0)
     parser.add_argument("--band", type=float, default=0.25)
     parser.add_argument("--variants", nargs="+", default=["main", "one"])
+    parser.add_argument("--bottom", type=float, default=1.0, help="folds: the smallest F scanned")
     parser.add_argument("--top", type=int, default=0, help="also print the top patches of the finer steps")
     return parser.parse_args(argv)
 
