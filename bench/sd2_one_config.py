@@ -25,7 +25,9 @@ Variants (``use``): ``main`` (today's mirror), ``one`` (the above), ``hybrid`` (
 G is an odd whole number, the one configuration from FAR_ODD away, a linear blend between),
 ``birth`` (the target blended from C on the tie line to the product P, main's lam = 1 target, on the
 birth lines: birth_weight), ``product-R`` (towards P within R of an odd G), ``follow`` (session 9, branch
-sd2j: main's layout for every record whose largest factor is at most 3, ``birth`` above; PLATEAU_TOP).
+sd2j: main's layout for every record whose largest factor is at most 3, ``birth`` above; PLATEAU_TOP),
+``follow-main`` (the same, main's own zone target M in place of the product P above 3:
+follow_main_layout).
 
     python bench/sd2_one_config.py folds [--variants follow --bottom 3]   # fold-over: exhaustive (F, G), 3 tips
     python bench/sd2_one_config.py model [--variants main one birth hybrid]   # model surface
@@ -211,17 +213,50 @@ def odd_weight(fixed: int, reach: float | None = None) -> float:
     return float(np.clip(1.0 - sd2.odd_distance(int(fixed)) / FIXED_ONE / reach, 0.0, 1.0))
 
 
+def follow_main_layout(f) -> tuple[np.ndarray, list, tuple]:
+    """(uv, triangles, chords) of the variant "follow-main": main's layout and vertex numbering; above
+    PLATEAU_TOP a fan in the zone puts its vertices at ``w radial + (1 - w)(beta C + (1 - beta) M)``, M
+    main's target (lam, centres), C the one configuration through the native map, beta = birth_weight
+    (1 on the tie line, 0 on the birth lines and where a = b + 2), its centres on their chords at
+    (1 - beta) mu; a grid takes C.  At or below PLATEAU_TOP: main's layout bitwise."""
+    if at_the_plateau_of_1(f):
+        return (*MAIN_PATTERN(f), MAIN_CHORDS(f))
+    lay = sd2._Layout(f)
+    if lay.shape == "sd2" and zone_weight(lay.f, lay.tip) is not None:
+        c = lay.tip
+        beta = birth_weight(lay.f[c], lay.f[(c + 1) % 3], lay.n[c], lay.n[(c + 1) % 3])
+        if beta > 0:
+            return blended_layout(f, 1.0 - beta)
+    elif lay.shape == "grid":
+        return blended_layout(f, 0.0)
+    return (*MAIN_PATTERN(f), MAIN_CHORDS(f))
+
+
 def hybrid_layout(f) -> tuple[np.ndarray, list, tuple]:
     """(uv, triangles, chords) of the hybrid: main's layout and vertex numbering, every vertex at
     sigma main + (1 - sigma) one-configuration (sigma = odd_weight of the base's factor, the grid's
     factor for a grid), the zone's centres on their chords at sigma mu (the one configuration puts
     them on (i, j+1): the fan's own diagonal, bench/sd2_tie_limits.py (A))."""
+    lay = sd2._Layout(f)
+    sigma = odd_weight(lay.f[(lay.tip + 1) % 3] if lay.shape == "sd2" else lay.f[0])
+    return blended_layout(f, sigma)
+
+
+def blended_layout(f, sigma: float) -> tuple[np.ndarray, list, tuple]:
+    """Main's layout and numbering, every vertex at sigma main + (1 - sigma) one-configuration (pure
+    C target: BIRTH_BLEND off), the zone's centres on their chords at sigma mu (the one configuration
+    puts them on (i, j+1): the fan's own diagonal, bench/sd2_tie_limits.py (A)); a hinted grid's
+    vertices likewise."""
     uv, triangles = MAIN_PATTERN(f)
     chords = MAIN_CHORDS(f)
     lay = sd2._Layout(f)
     if lay.shape == "sd2":
-        sigma = odd_weight(lay.f[(lay.tip + 1) % 3])
-        one_uv, _ = one_config_layout(f)
+        global BIRTH_BLEND
+        saved, BIRTH_BLEND = BIRTH_BLEND, False
+        try:
+            one_uv, _ = one_config_layout(f)
+        finally:
+            BIRTH_BLEND = saved
         k = len(one_uv)
         uv = uv.copy()
         uv[:k] = sigma * uv[:k] + (1 - sigma) * one_uv
@@ -231,7 +266,6 @@ def hybrid_layout(f) -> tuple[np.ndarray, list, tuple]:
             uv[vertices] = (1 - mu[:, None]) * uv[start] + mu[:, None] * uv[end]
             chords = (vertices, start, end, mu)
     elif lay.shape == "grid" and sd2.sd2_hint(f) is not None:
-        sigma = odd_weight(lay.f[0])
         n, g, x = lay.n[0], lay.tip, locations(lay.f[0]).astype(np.float64)
         uv = uv.copy()
         for i in range(2, n):
@@ -251,6 +285,15 @@ def hybrid_chords(f):
     return hybrid_layout(f)[2]
 
 
+def follow_main_pattern(f):
+    uv, triangles, _ = follow_main_layout(f)
+    return uv, triangles
+
+
+def follow_main_chords(f):
+    return follow_main_layout(f)[2]
+
+
 def no_chords(f):
     return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0, np.float32)
 
@@ -258,14 +301,16 @@ def no_chords(f):
 def use(variant: str) -> None:
     """Point the mirror (and the modules that imported its names) at main's pattern or a variant:
     "one", "hybrid" (main near odd base factors, FAR_ODD), "product-R" (the one configuration
-    with PRODUCT_REACH = R), "birth" (BIRTH_BLEND), "follow" (main up to PLATEAU_TOP, birth above)."""
+    with PRODUCT_REACH = R), "birth" (BIRTH_BLEND), "follow" (main up to PLATEAU_TOP, birth above),
+    "follow-main" (follow_main_layout)."""
     import test_sd2_pattern as model
     global PRODUCT_REACH, BIRTH_BLEND
     PRODUCT_REACH = float(variant.split("-")[1]) if variant.startswith("product-") else 0.0
     BIRTH_BLEND = variant in ("birth", "follow")
     variant = "one" if variant.startswith("product-") or variant == "birth" else variant
     pattern, chords = {"main": (MAIN_PATTERN, MAIN_CHORDS), "one": (one_config_pattern, no_chords),
-                       "hybrid": (hybrid_pattern, hybrid_chords), "follow": (follow_pattern, follow_chords)}[variant]
+                       "hybrid": (hybrid_pattern, hybrid_chords), "follow": (follow_pattern, follow_chords),
+                       "follow-main": (follow_main_pattern, follow_main_chords)}[variant]
     sd2.sd2_pattern, sd2.sd2_chords, model.sd2_pattern = pattern, chords, pattern
     object.__setattr__(sd2.SD2, "layout", pattern)  # a frozen dataclass
     object.__setattr__(sd2.SD2, "chords", chords)

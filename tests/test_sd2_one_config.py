@@ -138,3 +138,20 @@ def test_follow_is_continuous_at_births_above_3_and_jumps_where_it_leaves_main_w
         one_config.use("main")
     assert max(births) < 0.01 and max(lam_one) < 0.01, (births, lam_one)
     assert min(lam_below) > 0.05, lam_below
+
+
+def test_follow_main_has_no_seam_at_3_but_folds_where_it_blends_two_diagonals():
+    """The variant "follow-main" (main's own target M in place of P above 3): F crossing 3 with lam
+    below 1 is continuous (M on both sides), but the blend of C (the fan's own diagonal) with M (the
+    other diagonal, through main's centres) folds: phi (3.016, 3.020, 3.0007), tip 1, beta 0.8, lam
+    0.21, found among 1,500 random records near odd factors (main's smallest there -9.9e-9)."""
+    one_config.use("follow-main")
+    try:
+        seam = crossing_jump(lambda s: (3.0 + s, 2.4, 2.7), plateau_error(1))
+        record = hinted_record([round(x * FIXED_ONE) for x in (3.0159631, 3.01995121, 3.00074566)])
+        folded = signed_areas(*one_config.follow_main_pattern(record)).min()
+        main = signed_areas(*one_config.MAIN_PATTERN(record)).min()
+    finally:
+        one_config.use("main")
+    assert max(seam) < 0.01, seam
+    assert folded < -1e-6 and main > -1e-7, (folded, main)
