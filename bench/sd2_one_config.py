@@ -30,6 +30,7 @@ sd2j: main's layout for every record whose largest factor is at most 3, ``birth`
 follow_main_layout).
 
     python bench/sd2_one_config.py folds [--variants follow --bottom 3]   # fold-over: exhaustive (F, G), 3 tips
+    python bench/sd2_one_config.py folds --variants main follow-main --random 1500   # hinted records near 3, 5, 7
     python bench/sd2_one_config.py model [--variants main one birth hybrid]   # model surface
     python bench/sd2_one_config.py orbit --mesh sphere-320 --sweep 20 --steps 10 [sd2_pops options]
                                          [--variants main one] [--top 3]
@@ -340,6 +341,20 @@ def fold_scan(top: float = 11.0, step: int = FIXED_ONE // 32, base_step: int = F
     return worst, where, area_error
 
 
+def random_fold_scan(count: int, seed: int = 2):
+    """Smallest signed area over `count` random hinted records whose three phi lie within 0.02 (or
+    0.002) above 3, 5 or 7 (ties and births at odd factors approached from above), and its phi."""
+    import test_sd2_pattern as model
+    rng = np.random.default_rng(seed)
+    worst, where = np.inf, None
+    for _ in range(count):
+        phi = rng.choice([3, 5, 7]) + rng.uniform(0, 0.02, 3) * rng.choice([1.0, 0.1])
+        smallest = signed_areas(*sd2.sd2_pattern(model.hinted_record([round(x * FIXED_ONE) for x in phi]))).min()
+        if smallest < worst:
+            worst, where = float(smallest), np.round(phi, 5).tolist()
+    return worst, where
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("part", choices=("folds", "model", "orbit"))
@@ -348,6 +363,10 @@ def main(argv=None) -> int:
         options = orbit_arguments(rest)
         use(options.variants[-1])  # one by default; --variants follow --bottom 3: its layout above 3
         started = time.process_time()
+        if options.random:
+            worst, where = random_fold_scan(options.random)
+            print(f"smallest signed area {worst:.3g} at phi {where} ({time.process_time() - started:.0f} s CPU)")
+            return 0
         worst, where, area_error = fold_scan(bottom=options.bottom)
         print(f"smallest signed area {worst:.3g} at (F, G, tip) = {where}; area sum off 1/2 by {area_error:.2g} "
               f"({time.process_time() - started:.0f} s CPU)")
@@ -425,6 +444,7 @@ def orbit_arguments(argv):
     parser.add_argument("--band", type=float, default=0.25)
     parser.add_argument("--variants", nargs="+", default=["main", "one"])
     parser.add_argument("--bottom", type=float, default=1.0, help="folds: the smallest F scanned")
+    parser.add_argument("--random", type=int, default=0, help="folds: random hinted records near 3, 5, 7 instead")
     parser.add_argument("--top", type=int, default=0, help="also print the top patches of the finer steps")
     return parser.parse_args(argv)
 
