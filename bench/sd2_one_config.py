@@ -24,9 +24,13 @@ product); measured here, not removed.
 Variants (``use``): ``main`` (today's mirror), ``one`` (the above), ``hybrid`` (main's layout where
 G is an odd whole number, the one configuration from FAR_ODD away, a linear blend between),
 ``birth`` (the target blended from C on the tie line to the product P, main's lam = 1 target, on the
-birth lines: birth_weight), ``product-R`` (towards P within R of an odd G).
+birth lines: birth_weight), ``product-R`` (towards P within R of an odd G), ``follow`` (session 9, branch
+sd2j: main's layout for every record whose largest factor is at most 3, ``birth`` above; PLATEAU_TOP),
+``follow-main`` (the same, main's own zone target M in place of the product P above 3:
+follow_main_layout).
 
-    python bench/sd2_one_config.py folds            # fold-over: exhaustive (F, G) grid, 3 tips
+    python bench/sd2_one_config.py folds [--variants follow --bottom 3]   # fold-over: exhaustive (F, G), 3 tips
+    python bench/sd2_one_config.py folds --variants main follow-main --random 1500   # hinted records near 3, 5, 7
     python bench/sd2_one_config.py model [--variants main one birth hybrid]   # model surface
     python bench/sd2_one_config.py orbit --mesh sphere-320 --sweep 20 --steps 10 [sd2_pops options]
                                          [--variants main one] [--top 3]
@@ -172,6 +176,25 @@ PRODUCT_REACH = 0.0
 BIRTH_BLEND = False
 
 
+#: variant "follow" (session 9, branch sd2j; docs/sd2.md section 5, "Tenth pass"): today's zone (main's
+#: layout and chords: hint, lam, centres on the chord) for every record whose largest factor is at most
+#: PLATEAU_TOP (the plateau of 1 and every fan with a = 3 tip-edge segments), the birth variant above
+#: (C on the tie lines, the fan's own product on its birth lines); the two layouts are never blended
+PLATEAU_TOP = 3 * FIXED_ONE
+
+
+def at_the_plateau_of_1(f) -> bool:
+    return max(abs(int(x)) for x in f[:3]) <= PLATEAU_TOP
+
+
+def follow_pattern(f):
+    return MAIN_PATTERN(f) if at_the_plateau_of_1(f) else one_config_pattern(f)
+
+
+def follow_chords(f):
+    return MAIN_CHORDS(f) if at_the_plateau_of_1(f) else no_chords(f)
+
+
 def birth_weight(big: int, base: int, a: int, b: int) -> float:
     """beta: 1 on the tie line F = G, 0 where F reaches the odd a (rows are born past it) or G the odd
     a - 2 (columns were born there), and 0 where a = b + 2 (between the two births): in the bracket
@@ -191,17 +214,50 @@ def odd_weight(fixed: int, reach: float | None = None) -> float:
     return float(np.clip(1.0 - sd2.odd_distance(int(fixed)) / FIXED_ONE / reach, 0.0, 1.0))
 
 
+def follow_main_layout(f) -> tuple[np.ndarray, list, tuple]:
+    """(uv, triangles, chords) of the variant "follow-main": main's layout and vertex numbering; above
+    PLATEAU_TOP a fan in the zone puts its vertices at ``w radial + (1 - w)(beta C + (1 - beta) M)``, M
+    main's target (lam, centres), C the one configuration through the native map, beta = birth_weight
+    (1 on the tie line, 0 on the birth lines and where a = b + 2), its centres on their chords at
+    (1 - beta) mu; a grid takes C.  At or below PLATEAU_TOP: main's layout bitwise."""
+    if at_the_plateau_of_1(f):
+        return (*MAIN_PATTERN(f), MAIN_CHORDS(f))
+    lay = sd2._Layout(f)
+    if lay.shape == "sd2" and zone_weight(lay.f, lay.tip) is not None:
+        c = lay.tip
+        beta = birth_weight(lay.f[c], lay.f[(c + 1) % 3], lay.n[c], lay.n[(c + 1) % 3])
+        if beta > 0:
+            return blended_layout(f, 1.0 - beta)
+    elif lay.shape == "grid":
+        return blended_layout(f, 0.0)
+    return (*MAIN_PATTERN(f), MAIN_CHORDS(f))
+
+
 def hybrid_layout(f) -> tuple[np.ndarray, list, tuple]:
     """(uv, triangles, chords) of the hybrid: main's layout and vertex numbering, every vertex at
     sigma main + (1 - sigma) one-configuration (sigma = odd_weight of the base's factor, the grid's
     factor for a grid), the zone's centres on their chords at sigma mu (the one configuration puts
     them on (i, j+1): the fan's own diagonal, bench/sd2_tie_limits.py (A))."""
+    lay = sd2._Layout(f)
+    sigma = odd_weight(lay.f[(lay.tip + 1) % 3] if lay.shape == "sd2" else lay.f[0])
+    return blended_layout(f, sigma)
+
+
+def blended_layout(f, sigma: float) -> tuple[np.ndarray, list, tuple]:
+    """Main's layout and numbering, every vertex at sigma main + (1 - sigma) one-configuration (pure
+    C target: BIRTH_BLEND off), the zone's centres on their chords at sigma mu (the one configuration
+    puts them on (i, j+1): the fan's own diagonal, bench/sd2_tie_limits.py (A)); a hinted grid's
+    vertices likewise."""
     uv, triangles = MAIN_PATTERN(f)
     chords = MAIN_CHORDS(f)
     lay = sd2._Layout(f)
     if lay.shape == "sd2":
-        sigma = odd_weight(lay.f[(lay.tip + 1) % 3])
-        one_uv, _ = one_config_layout(f)
+        global BIRTH_BLEND
+        saved, BIRTH_BLEND = BIRTH_BLEND, False
+        try:
+            one_uv, _ = one_config_layout(f)
+        finally:
+            BIRTH_BLEND = saved
         k = len(one_uv)
         uv = uv.copy()
         uv[:k] = sigma * uv[:k] + (1 - sigma) * one_uv
@@ -211,7 +267,6 @@ def hybrid_layout(f) -> tuple[np.ndarray, list, tuple]:
             uv[vertices] = (1 - mu[:, None]) * uv[start] + mu[:, None] * uv[end]
             chords = (vertices, start, end, mu)
     elif lay.shape == "grid" and sd2.sd2_hint(f) is not None:
-        sigma = odd_weight(lay.f[0])
         n, g, x = lay.n[0], lay.tip, locations(lay.f[0]).astype(np.float64)
         uv = uv.copy()
         for i in range(2, n):
@@ -231,6 +286,15 @@ def hybrid_chords(f):
     return hybrid_layout(f)[2]
 
 
+def follow_main_pattern(f):
+    uv, triangles, _ = follow_main_layout(f)
+    return uv, triangles
+
+
+def follow_main_chords(f):
+    return follow_main_layout(f)[2]
+
+
 def no_chords(f):
     return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0, np.float32)
 
@@ -238,14 +302,16 @@ def no_chords(f):
 def use(variant: str) -> None:
     """Point the mirror (and the modules that imported its names) at main's pattern or a variant:
     "one", "hybrid" (main near odd base factors, FAR_ODD), "product-R" (the one configuration
-    with PRODUCT_REACH = R), "birth" (BIRTH_BLEND)."""
+    with PRODUCT_REACH = R), "birth" (BIRTH_BLEND), "follow" (main up to PLATEAU_TOP, birth above),
+    "follow-main" (follow_main_layout)."""
     import test_sd2_pattern as model
     global PRODUCT_REACH, BIRTH_BLEND
     PRODUCT_REACH = float(variant.split("-")[1]) if variant.startswith("product-") else 0.0
-    BIRTH_BLEND = variant == "birth"
+    BIRTH_BLEND = variant in ("birth", "follow")
     variant = "one" if variant.startswith("product-") or variant == "birth" else variant
     pattern, chords = {"main": (MAIN_PATTERN, MAIN_CHORDS), "one": (one_config_pattern, no_chords),
-                       "hybrid": (hybrid_pattern, hybrid_chords)}[variant]
+                       "hybrid": (hybrid_pattern, hybrid_chords), "follow": (follow_pattern, follow_chords),
+                       "follow-main": (follow_main_pattern, follow_main_chords)}[variant]
     sd2.sd2_pattern, sd2.sd2_chords, model.sd2_pattern = pattern, chords, pattern
     object.__setattr__(sd2.SD2, "layout", pattern)  # a frozen dataclass
     object.__setattr__(sd2.SD2, "chords", chords)
@@ -256,16 +322,18 @@ def signed_areas(uv, triangles):
     return 0.5 * ((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
 
 
-def fold_scan(top: float = 11.0, step: int = FIXED_ONE // 32, base_step: int = FIXED_ONE // 32):
-    """Smallest signed area of the one-configuration zone over F in [1, top] (step 16.16 units),
-    G in (F - 1, F] (base_step), the three tips; and the area sum (1/2)."""
+def fold_scan(top: float = 11.0, step: int = FIXED_ONE // 32, base_step: int = FIXED_ONE // 32,
+              bottom: float = 1.0):
+    """Smallest signed area of the variant's zone (the mirror's pattern as `use` set it) over F in
+    [bottom, top] (step 16.16 units), G in (F - 1, F] (base_step), the three tips; and the area sum
+    (1/2)."""
     worst, where, area_error = np.inf, None, 0.0
-    for big in range(FIXED_ONE, int(top * FIXED_ONE) + 1, step):
+    for big in range(int(bottom * FIXED_ONE), int(top * FIXED_ONE) + 1, step):
         for base in range(big, max(big - FIXED_ONE, FIXED_ONE - 1), -base_step):
             for c in range(3):
                 f = [0, 0, 0]
                 f[c], f[(c + 2) % 3], f[(c + 1) % 3] = big, big, base
-                uv, tri = one_config_pattern(f)
+                uv, tri = sd2.sd2_pattern(f)
                 areas = signed_areas(uv, tri)
                 area_error = max(area_error, abs(areas.sum() - 0.5))
                 if areas.min() < worst:
@@ -273,13 +341,33 @@ def fold_scan(top: float = 11.0, step: int = FIXED_ONE // 32, base_step: int = F
     return worst, where, area_error
 
 
+def random_fold_scan(count: int, seed: int = 2):
+    """Smallest signed area over `count` random hinted records whose three phi lie within 0.02 (or
+    0.002) above 3, 5 or 7 (ties and births at odd factors approached from above), and its phi."""
+    import test_sd2_pattern as model
+    rng = np.random.default_rng(seed)
+    worst, where = np.inf, None
+    for _ in range(count):
+        phi = rng.choice([3, 5, 7]) + rng.uniform(0, 0.02, 3) * rng.choice([1.0, 0.1])
+        smallest = signed_areas(*sd2.sd2_pattern(model.hinted_record([round(x * FIXED_ONE) for x in phi]))).min()
+        if smallest < worst:
+            worst, where = float(smallest), np.round(phi, 5).tolist()
+    return worst, where
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("part", choices=("folds", "model", "orbit"))
     args, rest = parser.parse_known_args(argv)
     if args.part == "folds":
+        options = orbit_arguments(rest)
+        use(options.variants[-1])  # one by default; --variants follow --bottom 3: its layout above 3
         started = time.process_time()
-        worst, where, area_error = fold_scan()
+        if options.random:
+            worst, where = random_fold_scan(options.random)
+            print(f"smallest signed area {worst:.3g} at phi {where} ({time.process_time() - started:.0f} s CPU)")
+            return 0
+        worst, where, area_error = fold_scan(bottom=options.bottom)
         print(f"smallest signed area {worst:.3g} at (F, G, tip) = {where}; area sum off 1/2 by {area_error:.2g} "
               f"({time.process_time() - started:.0f} s CPU)")
     elif args.part == "model":
@@ -355,6 +443,8 @@ def orbit_arguments(argv):
     parser.add_argument("--high", type=float, default=6.0)
     parser.add_argument("--band", type=float, default=0.25)
     parser.add_argument("--variants", nargs="+", default=["main", "one"])
+    parser.add_argument("--bottom", type=float, default=1.0, help="folds: the smallest F scanned")
+    parser.add_argument("--random", type=int, default=0, help="folds: random hinted records near 3, 5, 7 instead")
     parser.add_argument("--top", type=int, default=0, help="also print the top patches of the finer steps")
     return parser.parse_args(argv)
 
