@@ -7,19 +7,16 @@ import pytest
 
 from cltess.cli import main
 from cltess.io import load_scene
+from support import load_script
 
 ROOT = Path(__file__).resolve().parents[1]
 README = (ROOT / "README.md").read_text()
 
 
 def test_every_picture_exists_and_is_made_by_the_script():
-    import importlib.util
-
     linked = set(re.findall(r"\]\((docs/pictures/[^)]+\.png)\)", README))
     assert linked and all((ROOT / link).is_file() for link in linked)
-    spec = importlib.util.spec_from_file_location("make_pictures", ROOT / "docs" / "make_pictures.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    module = load_script(ROOT / "docs" / "make_pictures.py", "make_pictures")
     made = {f"docs/pictures/{name}" for name, _ in module.PICTURES}
     assert linked <= made
     assert {f"docs/pictures/{p.name}" for p in (ROOT / "docs" / "pictures").glob("*.png")} == made

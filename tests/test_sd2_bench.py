@@ -1,18 +1,14 @@
 """Smoke test of bench/sd2.py: the paper's base sizes, uniform factor 7 exactly 49 x base, and
 SD-2 against the transition pattern on the same factors as in the paper (about 1.1x)."""
-import importlib.util
-from pathlib import Path
-
 import numpy as np
 
-BENCH = Path(__file__).resolve().parents[1] / "bench" / "sd2.py"
+from support import ROOT, load_script
+
+BENCH = ROOT / "bench" / "sd2.py"
 
 
 def load_bench():
-    spec = importlib.util.spec_from_file_location("bench_sd2", BENCH)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script(BENCH, "bench_sd2")
 
 
 def test_scenes_have_the_papers_sizes_and_a_camera():

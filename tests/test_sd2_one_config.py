@@ -4,28 +4,15 @@ zone's (F, G) by hypothesis, every fan reaching the grid's configuration at a ti
 tie, a path past an isolated triple tie moving the mesh in proportion, and the birth obstruction
 (the fifth pass's (B)) as measured: the base's factor crossing an odd number inside the zone
 jumps for the tips whose corner c+2 is one of the configuration's pair."""
-import importlib.util
-import sys
-from pathlib import Path
-
 import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from cltess.patterns.fractional import FIXED_ONE, odd_segments
+from support import ROOT, load_script
 from test_sd2_pattern import hinted_record, lifted_distance, plateau_error, same_surface, signed_areas
 
-
-def _load_bench():
-    path = Path(__file__).resolve().parents[1] / "bench" / "sd2_one_config.py"
-    spec = importlib.util.spec_from_file_location("bench_sd2_one_config", path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
-
-
-one_config = _load_bench()
+one_config = load_script(ROOT / "bench" / "sd2_one_config.py", "bench_sd2_one_config")
 
 
 def fan(c: int, big: int, base: int) -> list:

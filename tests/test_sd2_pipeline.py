@@ -222,13 +222,8 @@ def test_no_pops_along_an_orbit(tessellator, case):
 
 
 def load_pops_bench():
-    import importlib.util
-    from pathlib import Path
-    path = Path(__file__).resolve().parents[1] / "bench" / "sd2_pops.py"
-    spec = importlib.util.spec_from_file_location("bench_sd2_pops", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    from support import ROOT, load_script
+    return load_script(ROOT / "bench" / "sd2_pops.py", "bench_sd2_pops")
 
 
 @pytest.mark.parametrize("function", ["bound", "silhouette", "silhouette-ramp", "depth"])

@@ -4,22 +4,9 @@ labels only (so for any positions of the grid's points); the partner-c+2 map nee
 diagonal; and at every odd m the product limits of two tips' maps differ (the birth obstruction)."""
 import pytest
 
-import importlib.util
-import sys
-from pathlib import Path
+from support import ROOT, load_script
 
-
-def _load_bench():
-    """bench/sd2_tie_limits.py by path (bench/ is no package; as test_sd2_pipeline loads sd2_pops)."""
-    path = Path(__file__).resolve().parents[1] / "bench" / "sd2_tie_limits.py"
-    spec = importlib.util.spec_from_file_location("bench_sd2_tie_limits", path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
-
-
-_bench = _load_bench()
+_bench = load_script(ROOT / "bench" / "sd2_tie_limits.py", "bench_sd2_tie_limits")
 birth_mismatches, blend_min_area, check_collapse = _bench.birth_mismatches, _bench.blend_min_area, _bench.check_collapse
 flipped_label, native_label, plateau_of_one = _bench.flipped_label, _bench.native_label, _bench.plateau_of_one
 

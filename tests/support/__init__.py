@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import importlib.util
 import os
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -19,12 +20,19 @@ SCENES = ROOT / "scenes"
 DATA = Path(os.environ.get("CLTESS_DATA", ROOT.parent / "shared" / "data"))
 
 
-def load_make_scenes():
-    """scenes/make_scenes.py as a module (it is a script, not part of the package)."""
-    spec = importlib.util.spec_from_file_location("make_scenes", SCENES / "make_scenes.py")
+def load_script(path: Path, name: str):
+    """A script (bench/, scenes/, docs/: no package) as module ``name``, registered in
+    sys.modules first (its dataclasses look their module up there)."""
+    spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
     spec.loader.exec_module(module)
     return module
+
+
+def load_make_scenes():
+    """scenes/make_scenes.py as a module (it is a script, not part of the package)."""
+    return load_script(SCENES / "make_scenes.py", "make_scenes")
 
 
 def random_patches(rng: np.random.Generator, count: int, spread: float = 5.0) -> np.ndarray:
