@@ -161,16 +161,22 @@ def shared_context(device: cl.Device) -> cl.Context:
     return _CONTEXTS[device]
 
 
+def switch_setting(name: str) -> bool | None:
+    """An on/off environment setting: "1" on, "0" off, unset or empty None (the default's)."""
+    chosen = os.environ.get(name)
+    if chosen not in (None, "", "0", "1"):
+        raise ValueError(f"{name}={chosen!r}: expected 0 or 1")
+    return chosen == "1" if chosen else None
+
+
 def default_fused_offsets(device: cl.Device) -> bool:
     """Stage 3 by stages/offsets.cl: ``CLTESS_FUSED_OFFSETS`` (0 or 1) if set, else on GPUs and
     on CPUs (one work-group: a GPU saves launches; on a CPU, where it runs on one core, only up to
     ``FUSED_OFFSETS_MAX_PATCHES_CPU`` patches, ``Tessellator.stage_counts``).  Not on a device
     that says it is both (Oclgrind: "all")."""
-    chosen = os.environ.get("CLTESS_FUSED_OFFSETS")
-    if chosen not in (None, "", "0", "1"):
-        raise ValueError(f"CLTESS_FUSED_OFFSETS={chosen!r}: expected 0 or 1")
-    if chosen:
-        return chosen == "1"
+    chosen = switch_setting("CLTESS_FUSED_OFFSETS")
+    if chosen is not None:
+        return chosen
     return bool(device.type & cl.device_type.GPU) != bool(device.type & cl.device_type.CPU)
 
 
@@ -181,11 +187,9 @@ def default_tiled_offsets(device: cl.Device) -> bool:
     time of the counts kernel and pyopencl.scan (killeroo 1.3-1.6 against 0.7-0.9 ms, spheres 3.7
     against 2.0, model zoo 8.5 against 4.0; bench/RESULTS.md, "Issue 15: a frame's host cost,
     session 5").  Not on a device that says it is both (Oclgrind: "all")."""
-    chosen = os.environ.get("CLTESS_TILED_OFFSETS")
-    if chosen not in (None, "", "0", "1"):
-        raise ValueError(f"CLTESS_TILED_OFFSETS={chosen!r}: expected 0 or 1")
-    if chosen:
-        return chosen == "1"
+    chosen = switch_setting("CLTESS_TILED_OFFSETS")
+    if chosen is not None:
+        return chosen
     return bool(device.type & cl.device_type.GPU) and not device.type & cl.device_type.CPU
 
 
@@ -193,11 +197,9 @@ def default_fused_crack_free(device: cl.Device) -> bool:
     """Stage 2 in stage 3's one launch for a Session frame (``Tessellator.fuses_crack_free``):
     ``CLTESS_FUSED_CRACK_FREE`` (0 or 1) if set, else where stage 3 is one launch by default
     (``default_fused_offsets``)."""
-    chosen = os.environ.get("CLTESS_FUSED_CRACK_FREE")
-    if chosen not in (None, "", "0", "1"):
-        raise ValueError(f"CLTESS_FUSED_CRACK_FREE={chosen!r}: expected 0 or 1")
-    if chosen:
-        return chosen == "1"
+    chosen = switch_setting("CLTESS_FUSED_CRACK_FREE")
+    if chosen is not None:
+        return chosen
     return default_fused_offsets(device)
 
 
@@ -912,13 +914,12 @@ class Tessellator:
         (stages/offsets.cl), from offsets[base] on; summary: (flags, their number, summary
         array) for ``offsets_summary``; crack_free: (stage 1's factors, edge groups, crack
         policy) to write ``factors`` first, every edge's (stages/crack_offsets.cl)."""
-        suffix = "" if summary is None else "_summary"
         if crack_free is None:
-            kernel = self.programs.kernel("offsets", "offsets" + suffix if suffix else None, pattern=pattern)
+            kernel = self.programs.kernel("offsets", None if summary is None else "offsets_summary", pattern=pattern)
             stage2 = (factors.data,)
         else:
             raw, groups, crack = crack_free
-            kernel = self.programs.kernel("crack_offsets", "crack_offsets" + suffix if suffix else None,
+            kernel = self.programs.kernel("crack_offsets", None if summary is None else "crack_offsets_summary",
                                           pattern=pattern, crack=crack)
             stage2 = (raw.data, groups["group_of"].data, groups["group_start"].data, groups["members"].data,
                       groups["collapsed"].data, np.uint32(raw.size), factors.data)
