@@ -50,9 +50,10 @@ def _fast_bez(data: bytes) -> np.ndarray | None:
     if arity[0] not in (3, 4) or (arity != arity[0]).any() or (commas[vertex_lines] != arity - 1).any():
         return None
     values = numbers.values
-    indices = values[numbers.first[1]:numbers.first[1] + 16 * num].astype(np.int64)
-    if ((indices < 1) | (indices > num_vertices)).any():
+    indices = values[numbers.first[1]:numbers.first[1] + 16 * num]
+    if ((indices < 1) | (indices > num_vertices)).any():  # in float64, before a cast that could overflow
         return None
+    indices = indices.astype(np.int64)
     start = int(numbers.first[2 + num])
     vertices = values[start:start + int(arity[0]) * num_vertices].reshape(num_vertices, int(arity[0]))
     if arity[0] == 3:
