@@ -20,5 +20,5 @@ for r in rows point; do
 done
 ls -la $R
 { uptime; nvidia-smi --query-gpu=clocks.sm,clocks.mem,temperature.gpu --format=csv; } >> $R/machine.txt 2>&1
-tar -czf $OUT/gpu15h_run1.tgz -C $OUT raw
+tar -czf $OUT/gpu15h_run1.tgz -C $OUT --exclude="*.ncu-rep" raw; tar -czf $OUT/gpu15h_run1_reps.tgz -C $OUT/raw rows.ncu-rep point.ncu-rep
 tail -22 $R/stage45.txt; tail -8 $R/ncu_opencl_check.txt $R/replay_rows.txt $R/replay_point.txt; tail -4 $R/ncu_rows_log.txt $R/ncu_point_log.txt; head -c 600 $R/rows_sass.csv
