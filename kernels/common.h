@@ -63,10 +63,12 @@ inline float3 unit_or_zero(float3 a)
  * bits without dividing a zero. */
 
 /* a / b for b > 0 (+inf included): a zero a (either sign) is its own quotient exactly, and the
- * division, made with the dividend 1 there, is not used. */
+ * division, made with the dividend 1 there, is not used.  The dividend's zero test is on a's bits
+ * (shifted past the sign), unlike the result's: NVIDIA's compiler folded `a == 0 ? 1 : a` inside
+ * `a == 0 ? a : ...` back to a, so the slow path stayed (H200, run 2). */
 inline float quotient_by_positive(float a, float b)
 {
-    float q = (a == 0.0f ? 1.0f : a) / b;
+    float q = ((as_uint(a) << 1) == 0u ? 1.0f : a) / b;
     return a == 0.0f ? a : q;
 }
 
