@@ -9,7 +9,7 @@ for t in ../gpu15h-base ../gpu15h-div ../gpu15h-local; do (cd $t && ln -sfn ../k
 R=$OUT/raw; mkdir -p $R
 set -x
 { date -u; nvidia-smi --query-gpu=name,driver_version,clocks.max.sm,clocks.sm,clocks.mem --format=csv; uptime; } > $R/machine.txt 2>&1
-timeout 150 python3 bench/gpu_stage45.py --device nvidia --repeat 10 --json $R/stage45.json --variant main rows-prep ../gpu15h-base - --variant branch rows-prep . - --variant div-only rows-prep ../gpu15h-div - --variant local-only rows-prep ../gpu15h-local - --variant main-again rows-prep ../gpu15h-base - --variant branch-again rows-prep . - --variant branch-point point . - > $R/stage45.txt 2>&1
+timeout 150 python3 bench/gpu_stage45.py --device nvidia --repeat 10 --json $R/stage45.json --variant main rows-prep ../gpu15h-base - --variant branch rows-prep . - --variant div-only rows-prep ../gpu15h-div - --variant local-only rows-prep ../gpu15h-local - --variant main-again rows-prep ../gpu15h-base - --variant branch-again rows-prep . - --variant main-point point ../gpu15h-base - --variant branch-point point . - > $R/stage45.txt 2>&1
 S="tea_table double_torus killeroo herd spheres star_field model_zoo elephant"
 for t in ../gpu15h-base .; do PYTHONPATH=/tmp/site:$PWD/$t timeout 40 python3 bench/frame_hashes.py --device nvidia $S; done > $R/hashes.txt 2>&1
 timeout 60 python3 bench/ncu_stage45.py --repeat 20 --json $R/replay_rows.json > $R/replay_rows.txt 2>&1
