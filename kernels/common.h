@@ -65,7 +65,9 @@ inline float3 unit_or_zero(float3 a)
 /* a / b for b > 0 (+inf included): a zero a (either sign) is its own quotient exactly, and the
  * division, made with the dividend 1 there, is not used.  The dividend's zero test is on a's bits
  * (shifted past the sign), unlike the result's: NVIDIA's compiler folded `a == 0 ? 1 : a` inside
- * `a == 0 ? a : ...` back to a, so the slow path stayed (H200, run 2). */
+ * `a == 0 ? a : ...` back to a, so the slow path stayed (H200, run 2).  (A device that flushed
+ * subnormals in the comparison `a == 0.0f` but not in a select would differ on a subnormal a; the
+ * three runtimes the tests run compare them as nonzero: tests/test_unit_normal.py's +-1e-40.) */
 inline float quotient_by_positive(float a, float b)
 {
     float q = ((as_uint(a) << 1) == 0u ? 1.0f : a) / b;
