@@ -53,6 +53,65 @@ inline float3 unit_or_zero(float3 a)
     return len > 0.0f ? a / len : (float3)(0.0f);
 }
 
+/* --- division without a zero dividend (issue 15, NVIDIA) ---------------------------------------
+ * NVIDIA's correctly rounded division (div.rn.f32: MUFU.RCP, a refinement and FCHK) calls a slow
+ * path, out of line, wherever FCHK finds an operand outside its fast range: a zero dividend is
+ * one.  A teapot's normals have exact zero components (its symmetry planes), so in stage 4's
+ * prepared_rows at uniform level 16 on the H200 that subroutine held 9% of the warps' sampled
+ * time, its call sites about 5% more, a call on every point in some lane (Nsight Compute,
+ * bench/RESULTS.md, "Issue 15: stage 4 under Nsight Compute on the H200").  These give the same
+ * bits without dividing a zero. */
+
+/* a / b for b > 0 (+inf included): a zero a (either sign) is its own quotient exactly, and the
+ * division, made with the dividend 1 there, is not used.  The dividend's zero test is on a's bits
+ * (shifted past the sign), unlike the result's: NVIDIA's compiler folded `a == 0 ? 1 : a` inside
+ * `a == 0 ? a : ...` back to a, so the slow path stayed (H200, run 2).  (A device that flushed
+ * subnormals in the comparison `a == 0.0f` but not in a select would differ on a subnormal a; the
+ * three runtimes the tests run compare them as nonzero: tests/test_unit_normal.py's +-1e-40.) */
+inline float quotient_by_positive(float a, float b)
+{
+    float q = ((as_uint(a) << 1) == 0u ? 1.0f : a) / b;
+    return a == 0.0f ? a : q;
+}
+
+#if defined(cl_nv_pragma_unroll) && !defined(CLTESS_BUILTIN_LENGTH)
+/* NVIDIA's OpenCL compiler (it defines cl_nv_pragma_unroll): length(n) spelled out as it expands
+ * length(float3) (its PTX, driver 580): m the largest of |x|, |y|, |z| (compared in that order);
+ * 0 where m is 0; +inf where a component is infinite; else m * sqrt((|x| / m)^2 + (|y| / m)^2 +
+ * (|z| / m)^2), the first square a product and the next two fused, every division and the root
+ * correctly rounded (the programs' -cl-fp32-correctly-rounded-divide-sqrt).  Here a zero
+ * component's quotient is 0 without the division: |c| / m is +0 exactly for m > 0 finite, and
+ * where m is a NaN another component is one, whose quotient makes the sum a NaN either way
+ * (tests/test_unit_normal.py compares it with length() bit for bit on the device). */
+#define CLTESS_SPELLED_LENGTH 1
+inline float normal_length(float3 n)
+{
+    float a = fabs(n.x), b = fabs(n.y), c = fabs(n.z);
+    float m = a < b ? b : a;
+    m = m < c ? c : m;
+    if (m == 0.0f)
+        return 0.0f;
+    if (a == INFINITY || b == INFINITY || c == INFINITY)
+        return INFINITY;
+    float qa = quotient_by_positive(a, m), qb = quotient_by_positive(b, m), qc = quotient_by_positive(c, m);
+    float sum = fma(qc, qc, fma(qb, qb, qa * qa));
+    return m * sqrt(sum);
+}
+#else
+#define CLTESS_SPELLED_LENGTH 0
+inline float normal_length(float3 n) { return length(n); }
+#endif
+
+/* n / length(n) where that is > 0, else `otherwise`: bitwise what that expression gives (the
+ * length as length(), the quotients as /), without dividing a zero. */
+inline float3 unit_or(float3 n, float3 otherwise)
+{
+    float len = normal_length(n);
+    if (!(len > 0.0f))
+        return otherwise;
+    return (float3)(quotient_by_positive(n.x, len), quotient_by_positive(n.y, len), quotient_by_positive(n.z, len));
+}
+
 /* Power-form coefficients of the cubic Bernstein polynomial with controls c. */
 inline void power_form(const float4 c[4], float4 a[4])
 {

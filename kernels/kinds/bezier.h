@@ -151,8 +151,7 @@ ALWAYS_INLINE float3 surface_normal(const float4 b[16], float u, float v, float4
             n = tangent_cross(projected(s), s_u, s_v, &ok);
         }
     }
-    float len = length(n);
-    return len > 0.0f ? n / len : (float3)(0.0f, 0.0f, 1.0f);
+    return unit_or(n, (float3)(0.0f, 0.0f, 1.0f));  /* n / length(n), or +z (common.h: no zero divided) */
 }
 
 /* The 4 control points of edge e, counter-clockwise (cltess/scene.py, boundary_curves). */

@@ -118,6 +118,10 @@ void prepared_rows(__global const kind_patch *restrict prepared, __global const 
     __local ulong line_at[LINE_GROUP];     /* output slot of each work-item's first staged point */
     __local int line_count[LINE_GROUP], line_patch[LINE_GROUP], line_object[LINE_GROUP];
     __local int round_length;
+    /* each patch's factors, first output slot, object, rows, and whether it has vertices */
+    __local int4 group_factors[LINE_MAX_PATCHES];
+    __local ulong group_vertex[LINE_MAX_PATCHES];
+    __local int group_object[LINE_MAX_PATCHES], group_rows[LINE_MAX_PATCHES], group_has[LINE_MAX_PATCHES];
 #if !PATTERN_UNIFORM_ROWS
     forward_differencing = 0;  /* the rows' points are not equally spaced (patterns/layout.h) */
 #endif
@@ -127,14 +131,27 @@ void prepared_rows(__global const kind_patch *restrict prepared, __global const 
     vertex_out out = {positions, normals, uv, patch_ids, object_ids};
     uint item = (uint)get_local_id(0), group_first = first_patch + (uint)get_group_id(0) * patches_per_group;
     uint patches = min(patches_per_group, last - group_first);  /* the host launches no group past the batch */
+    /* The group's patches, a work-item each, to local memory: a round's lines read them there, not
+     * from global memory after the round's first local read (Nsight Compute on the H200: those
+     * dependent loads held 13% of the warps' sampled time; bench/RESULTS.md, "Issue 15: stage 4
+     * under Nsight Compute on the H200"). */
+    for (uint q = item; q < patches; q += LINE_GROUP) {
+        uint p = group_first + q;
+        ulong from = vertex_offsets[p], to = vertex_offsets[p + 1];
+        int4 raw = factors[p];
+        int collapsed;
+        group_factors[q] = raw;
+        group_vertex[q] = from - vertex_base;
+        group_object[q] = patch_objects[p];
+        group_has[q] = to > from;
+        group_rows[q] = to > from ? pattern_rows(patch_factors(raw, &collapsed)) : 0;
+    }
+    barrier(CLK_LOCAL_MEM_FENCE);
     if (item == 0) {  /* the group's rows, patch by patch (none for a patch without vertices) */
         uint rows = 0;
         for (uint q = 0; q < patches; ++q) {
             row_first[q] = rows;
-            uint p = group_first + q;
-            int collapsed;
-            if (vertex_offsets[p + 1] > vertex_offsets[p])
-                rows += (uint)pattern_rows(patch_factors(factors[p], &collapsed));
+            rows += (uint)group_rows[q];
         }
         row_first[patches] = rows;
     }
@@ -153,10 +170,10 @@ void prepared_rows(__global const kind_patch *restrict prepared, __global const 
         }
         uint p = group_first + q;
         int collapsed = 0;
-        int4 f = patch_factors(factors[p], &collapsed);
+        int4 f = patch_factors(group_factors[q], &collapsed);
         ulong at = 0;
-        if (line < lines && vertex_offsets[p + 1] > vertex_offsets[p])
-            at = vertex_offsets[p] - vertex_base + line_start(f, edge, row, &count);
+        if (line < lines && group_has[q])
+            at = group_vertex[q] + line_start(f, edge, row, &count);
         kind_row walk;
         kind_patch patch;
         if (count > 0 && edge < 0 && forward_differencing) {
@@ -194,7 +211,7 @@ void prepared_rows(__global const kind_patch *restrict prepared, __global const 
             line_at[item] = at + (ulong)k;
             line_count[item] = staging;
             line_patch[item] = (int)p;
-            line_object[item] = staging ? patch_objects[p] : 0;
+            line_object[item] = staging ? group_object[q] : 0;
             barrier(CLK_LOCAL_MEM_FENCE);
             for (uint t = item; t < LINE_GROUP * LINE_CHUNK; t += LINE_GROUP) {  /* consecutive t: one line's points */
                 uint from = t / LINE_CHUNK, s = t % LINE_CHUNK, slot = from * (LINE_CHUNK + 1) + s;
