@@ -91,7 +91,7 @@ def transition_on(tessellator, plan, factors: np.ndarray):
     control points; (Tessellation, device ms of stages 3-5)."""
     import pyopencl.array as cl_array
 
-    from cltess.backends.opencl.tessellator import _span_ms
+    from cltess.backends.opencl.events import span_ms
 
     queue = tessellator.queue
     part = plan.parts[0]
@@ -105,7 +105,7 @@ def transition_on(tessellator, plan, factors: np.ndarray):
     triangles, index_events = tessellator.stage_indices(device, vertex_offsets, index_offsets, (0, indices),
                                                         (0, count), kind=TRI_TRANSITION)
     queue.finish()
-    ms = sum(_span_ms(e) for e in (counts[:1], counts[1:], vertex_events, index_events) if e)
+    ms = sum(span_ms(e) for e in (counts[:1], counts[1:], vertex_events, index_events) if e)
     tess = Tessellation(triangles=triangles.get(), factors=factors, stage_ms={"stages 3-5": ms},
                         **{k: a.get() for k, a in out.items()})
     return tess, ms

@@ -446,7 +446,7 @@ def _load(path, options: BatchOptions):
 def plan_task(path: str, options: BatchOptions, slots: dict):
     """On a worker: load the scene and run stages 1-3 once; the HostPlan (kept on the
     cluster) and its stage times."""
-    from .backends.opencl.tessellator import _span_ms
+    from .backends.opencl.events import span_ms
 
     scene = _load(path, options)
     tessellator = _worker_tessellator(options.device, slots)
@@ -456,7 +456,7 @@ def plan_task(path: str, options: BatchOptions, slots: dict):
         kwargs.pop("sharp_edges")
     plan = tessellator.plan(scene, **kwargs)
     tessellator.queue.finish()
-    stage_ms = {stage: _span_ms(events) for stage, events in plan.events.items() if events}
+    stage_ms = {stage: span_ms(events) for stage, events in plan.events.items() if events}
     return plan.to_host(), stage_ms, _worker_budget(tessellator, options), tessellator.device.name.strip()
 
 

@@ -1,7 +1,8 @@
 """The engine's former home, kept as re-exports for one release: the OpenCL backend is
 ``cltess.backends.opencl``, the kinds ``cltess.kinds``."""
 from .backends.opencl.programs import STAGES, Programs, kernel_dir
-from .backends.opencl.tessellator import WORK_GROUP, Plan, PlanPart, Tessellator
+from .backends.opencl.plan import Plan, PlanPart
+from .backends.opencl.tessellator import WORK_GROUP, Tessellator
 from .kinds import BEZIER, FACTOR_SLOTS, KINDS, PN, BezierKind, KindInput, PatchKind, PNKind
 from .tessellation import BYTES_PER_INDEX, BYTES_PER_VERTEX
 

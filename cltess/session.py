@@ -37,7 +37,8 @@ import dataclasses
 import time
 
 from .backends.opencl.recorded import RecordedFrame
-from .backends.opencl.tessellator import OutputBuffers, Tessellator
+from .backends.opencl.output import OutputBuffers
+from .backends.opencl.tessellator import Tessellator
 from .criteria.tolerance import ObjectSpace, ScreenSpace
 from .request import Request
 from .scene import Camera, Scene

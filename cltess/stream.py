@@ -150,7 +150,7 @@ def _overlapped(tessellator, plan, ranges, forward_differencing: bool):
     buffers take turns (``OutputBuffers``: reused, so allocated and first touched once; on a
     GPU read back through page-locked memory).  A batch the device has no memory for is
     split in two (``_emit_fitting``)."""
-    from .backends.opencl.tessellator import OutputBuffers
+    from .backends.opencl.output import OutputBuffers
 
     if not hasattr(tessellator, "emit_async"):  # another backend: one batch after the other
         for first, last in ranges:

@@ -1,4 +1,5 @@
 """The OpenCL backend."""
-from .tessellator import Plan, Tessellator
+from .plan import Plan
+from .tessellator import Tessellator
 
 __all__ = ["Plan", "Tessellator"]

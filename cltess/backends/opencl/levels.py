@@ -34,7 +34,9 @@ import pyopencl.array as cl_array
 from ...patterns.semi_uniform import interior_template, point_template
 from ...tessellation import Tessellation
 from .scan_kernel import GenericScanKernel
-from .tessellator import WORK_GROUP, Plan, Tessellator, _span_ms
+from .events import span_ms
+from .plan import Plan
+from .tessellator import WORK_GROUP, Tessellator
 
 #: m = log2 of the patch's largest factor (its records are 2^p_e; a collapsed edge's stored
 #: negated, common.h patch_factors), -1 when culled.
@@ -185,7 +187,7 @@ def emit_by_level(tessellator: Tessellator, plan: Plan, first: int = 0, last: in
                 tessellator.queue, _global(size), (WORK_GROUP,), *common, plan.index_offsets.data, *slots, index_base,
                 triangles.data))
     tessellator.queue.finish()
-    stage_ms = {stage: _span_ms(evs) for stage, evs in events.items() if evs}
+    stage_ms = {stage: span_ms(evs) for stage, evs in events.items() if evs}
     stages_ms = (time.perf_counter() - (plan.started if first == 0 else started)) * 1e3
     levels = [histogram.get(level, 0) for level in range(max(histogram, default=-1) + 1)]
     stats = dict(plan.stats, first_patch=first, last_patch=last, level_queues=levels)

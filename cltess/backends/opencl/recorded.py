@@ -24,7 +24,8 @@ from dataclasses import dataclass
 import pyopencl._cl as _cl
 
 from .programs import same_arguments
-from .tessellator import TOLERANCE_ARGUMENTS, PendingEmit, Plan, SceneData
+from .plan import Plan, SceneData
+from .tessellator import TOLERANCE_ARGUMENTS, PendingEmit
 
 #: A frame's stages in the order of their launches, stage 3's summary read after "counts".
 PLANNED_STAGES = ("factors", "crack_free", "counts")

@@ -35,7 +35,8 @@ from ...patterns.semi_uniform import level_histogram
 from ...request import Request
 from ...scene import Camera, Scene
 from ...tessellation import Tessellation
-from .tessellator import WORK_GROUP, Tessellator, _global_size, _span_ms
+from .events import span_ms
+from .tessellator import WORK_GROUP, Tessellator, _global_size
 
 #: The paper's typical maximum level M (section 5).
 DEFAULT_SILHOUETTE_LEVEL = 3
@@ -221,7 +222,7 @@ class SilhouetteRefiner:
                                                     (part.base, part.base + part.count), kind=part.pattern,
                                                     out=triangles)[1]
         queue.finish()
-        stage_ms = {stage: _span_ms(evs) for stage, evs in events.items() if evs}
+        stage_ms = {stage: span_ms(evs) for stage, evs in events.items() if evs}
         records = self._records.get()
         alpha = self._alpha.get()[:self.edges.num_groups]
         stage_ms["total_wall"] = (time.perf_counter() - started) * 1e3

@@ -19,10 +19,9 @@ and every ``cltess.Session`` frame: ``OutputBuffers``, ``DeviceOutput``).
 """
 from __future__ import annotations
 
-import math
 import os
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import pyopencl as cl
@@ -32,15 +31,17 @@ import pyopencl.tools as cl_tools
 from ...criteria.tolerance import ObjectSpace, ScreenSpace
 from ...crack.adjacency import merge_edge_groups
 from ...device import pick_device
-from ...limits import OutputTooLarge, check_totals
-from ...kinds import BEZIER, FACTOR_SLOTS, FLAG_CULLED, FLAG_SATURATED, KINDS, PN, PatchKind
+from ...kinds import BEZIER, FACTOR_SLOTS, KINDS, PN, PatchKind
 from ...kinds import kind as kind_named
 from ...patterns import PATTERNS, Pattern
 from ...patterns.semi_uniform import DEFAULT_MAX_LEVEL, level_histogram
 from ...request import Request
 from ...scene import Scene
-from ...tessellation import BYTES_PER_INDEX, BYTES_PER_VERTEX, VERTEX_RECORD, DeviceOutput, Tessellation
+from ...tessellation import VERTEX_RECORD, DeviceOutput, Tessellation
+from .events import span_ms, wait_ms
 from .level_functions import build_level_function_programs, level_factors
+from .output import OutputBuffers
+from .plan import HostPlan, Plan, PlanPart, SceneData
 from .programs import WORK_GROUP, Programs
 from .strips import build_strip_programs, emit_strips, strip_offsets, strip_parts
 
@@ -221,18 +222,6 @@ VERIFY_ORDER = 6  # Tessellator.verify: 28 points per triangle, corners and edge
 VERIFY_MAX_TRIANGLES = 4_000_000  # above this, every k-th triangle is verified
 
 
-@dataclass
-class PlanPart:
-    """One kind's patches in a plan: scene numbers ``base .. base + count - 1``, tessellated
-    with ``pattern``; data: its device arrays ("source", "controls")."""
-
-    kind: PatchKind
-    pattern: Pattern
-    base: int
-    count: int
-    data: dict
-
-
 def _pattern(kind_or_pattern) -> Pattern:
     return kind_or_pattern if isinstance(kind_or_pattern, Pattern) else kind_named(kind_or_pattern).pattern
 
@@ -264,19 +253,6 @@ def _record_groups(records: int, per_item: int) -> tuple[int]:
 TOLERANCE_ARGUMENTS = slice(4, 9)
 
 
-def wait_ms(events) -> float:
-    """Wait for events; the host milliseconds spent blocked (a frame's wall_ms["waits"])."""
-    started = time.perf_counter()
-    cl.wait_for_events(events)
-    return (time.perf_counter() - started) * 1e3
-
-
-def _span_ms(events) -> float:
-    """Device milliseconds from the first event's start to the last one's end."""
-    return (events[-1].get_profiling_info(_END) - events[0].get_profiling_info(_START)) * 1e-6
-
-
-_START, _END = cl.profiling_info.START, cl.profiling_info.END
 
 
 class Tessellator:
@@ -716,7 +692,7 @@ class Tessellator:
                          "verify_patch": int(tess.patch_ids[tess.triangles[triangle, 0] - vertex_base])}
             measured += samples
         return dict(worst, verify_triangles=measured, verify_stride=stride, verify_order=order,
-                    verify_ms=_span_ms(events) if events else 0.0)
+                    verify_ms=span_ms(events) if events else 0.0)
 
     # --- stages 4-5 from a plan made elsewhere (issue 17, cltess/batch.py) -----------------------
 
@@ -1075,56 +1051,6 @@ def combine_verified(parts: list[dict]) -> dict:
                 verify_ms=sum(p["verify_ms"] for p in parts))
 
 
-class _Raw:
-    """A buffer where the stage functions expect an array (they read ``.data`` only)."""
-
-    __slots__ = ("data",)
-
-    def __init__(self, data):
-        self.data = data
-
-
-class OutputArrays(dict):
-    """The pyopencl arrays of one output (name -> ``pyopencl.array.Array``, made on first
-    access: a frame whose output nobody looks at on the device does not pay for them)."""
-
-    def __init__(self, queue, fields: dict, buffers: dict, num_vertices: int, num_triangles: int):
-        """fields: name -> (dtype, per-row shape) (``OutputBuffers.FIELDS``); buffers: name ->
-        device buffer."""
-        super().__init__()
-        self.queue, self.layout, self.buffers = queue, fields, buffers
-        self.num_vertices, self.num_triangles = num_vertices, num_triangles
-
-    def raw(self, name: str) -> _Raw:
-        return _Raw(self.buffers[name])
-
-    def __contains__(self, name) -> bool:
-        return name in self.layout
-
-    def __missing__(self, name):
-        if name not in self.layout:
-            raise KeyError(name)
-        dtype, shape = self.layout[name]
-        rows = self.num_triangles if name == "triangles" else self.num_vertices
-        self[name] = cl_array.Array(self.queue, (rows, *shape), dtype, data=self.buffers[name])
-        return self[name]
-
-    def keys(self):
-        return self.layout.keys()
-
-    def values(self):
-        return [self[name] for name in self.layout]
-
-    def items(self):
-        return [(name, self[name]) for name in self.layout]
-
-    def __iter__(self):
-        return iter(self.layout)
-
-    def __len__(self) -> int:
-        return len(self.layout)
-
-
 @dataclass
 class _Ready:
     """An emit that ran synchronously, with PendingEmit's ``result``."""
@@ -1189,7 +1115,7 @@ class PendingEmit:
             tess.stats = times["stats"]
             all_events = [event for evs in events.values() for event in evs]
             waited = wait_ms(all_events) if all_events else 0.0
-            tess.stage_ms = {stage: _span_ms(evs) for stage, evs in events.items() if evs}
+            tess.stage_ms = {stage: span_ms(evs) for stage, evs in events.items() if evs}
             tess.wall_ms = times["wall_ms"] = {"stages": (time.perf_counter() - plan.started) * 1e3,
                                                "waits": (plan.wait_ms if first == 0 else 0.0) + waited}
             tess.stage_ms["total_wall"] = tess.wall_ms["stages"]  # until the host arrays: Tessellation.fetch
@@ -1211,365 +1137,3 @@ class PendingEmit:
             tess.fetch()
             tess.device = None  # the device buffers go when the caller drops nothing but the host arrays
         return tess
-
-
-class OutputBuffers:
-    """The output buffers of stages 4-5 on one device: one per field of the vertex record
-    (``VERTEX_RECORD``) and one of triangles, kept and grown only when an output needs more
-    (by a quarter more than asked, so a slowly growing output does not reallocate every frame).
-
-    How the output reaches host arrays (``read_back``) depends on the device:
-
-    * a CPU device: the buffers are sub-buffers of one allocation with ``CL_MEM_ALLOC_HOST_PTR``,
-      *mapped* at once: the host arrays are the buffers' own memory, no copy (``_take_mapped``);
-    * another device with ``pinned=True`` (a ``Session``): copied into page-locked host buffers
-      (``ALLOC_HOST_PTR``, mapped once and kept), which DMA engines fill at the bus's rate;
-    * otherwise copied into fresh (pageable) NumPy arrays.
-
-    Every ``take`` starts a new generation: a result of an earlier one is stale (its arrays
-    will be overwritten), which ``DeviceOutput.valid`` reports.  Host arrays from a mapping or
-    a pinned buffer are views of memory the next ``take`` reuses too.
-    """
-
-    GROWTH = 1.25
-
-    def __init__(self, tessellator: "Tessellator", pinned: bool = False):
-        self.queue = tessellator.queue
-        self.context = tessellator.context
-        self.mapped = bool(tessellator.device.type & cl.device_type.CPU)
-        self.pinned = pinned and not self.mapped
-        self.generation = 0
-        self._buffers: dict = {}  # name -> (device buffer, capacity in rows)
-        self._staging: dict = {}  # name -> (pinned buffer, its mapped host array)
-        self._maps: list = []
-        self.read_back_wait_ms = 0.0  # host ms blocked in the last read_back
-        self._parent = None  # a mapped device's one allocation (_take_mapped), its fields' offsets
-        self._offsets: dict = {}
-        self._capacity = (0, 0)  # (vertices, triangles) of the buffers (_grow)
-        self._field_buffers: dict = {}  # name -> device buffer (_grow)
-
-    #: (name, dtype, per-row shape) of every output buffer: the vertex record, then triangles.
-    LAYOUT = tuple((name, np.dtype(dtype), shape) for name, dtype, shape in VERTEX_RECORD) + \
-        (("triangles", np.dtype(np.uint32), (3,)),)
-    #: name -> (dtype, per-row shape), as OutputArrays reads them.
-    FIELDS = {name: (dtype, shape) for name, dtype, shape in LAYOUT}
-
-    @classmethod
-    def _layout(cls):
-        return cls.LAYOUT
-
-    def take(self, num_vertices: int, num_triangles: int) -> dict:
-        """pyopencl arrays of (num_vertices, ...) per vertex field and (num_triangles, 3)
-        triangles, on buffers at least that large; a new generation.  Within the buffers'
-        capacity (frame after frame of a Session) nothing but the generation changes."""
-        self.generation += 1
-        self.unmap()
-        vertices, triangles = self._capacity
-        if num_vertices > vertices or num_triangles > triangles or not self._buffers:
-            self._grow(num_vertices, num_triangles)
-        return OutputArrays(self.queue, self.FIELDS, self._field_buffers, num_vertices, num_triangles)
-
-    def _grow(self, num_vertices: int, num_triangles: int) -> None:
-        """Buffers for at least this many vertices and triangles (the first allocation as asked;
-        growing, a quarter more)."""
-        layout = self._layout()
-        if self.mapped:
-            self._take_mapped(layout, num_vertices, num_triangles)
-        else:
-            flags = cl.mem_flags.READ_WRITE
-            for name, dtype, shape in layout:
-                rows = num_triangles if name == "triangles" else num_vertices
-                row_bytes = dtype.itemsize * math.prod(shape)
-                buffer, capacity = self._buffers.get(name, (None, -1))
-                if rows > capacity:
-                    capacity = rows if buffer is None else int(rows * self.GROWTH)
-                    self._buffers.pop(name, None)
-                    self._staging.pop(name, None)
-                    buffer = cl.Buffer(self.context, flags, max(capacity, 1) * row_bytes)
-                    self._buffers[name] = (buffer, capacity)
-        self._field_buffers = {name: self._buffers[name][0] for name, _, _ in layout}
-        self._capacity = (min(capacity for name, (_, capacity) in self._buffers.items() if name != "triangles"),
-                          self._buffers["triangles"][1])
-
-    def _take_mapped(self, layout, num_vertices: int, num_triangles: int) -> None:
-        """A CPU device's buffers: every field a sub-buffer of one ``ALLOC_HOST_PTR`` allocation
-        (each at a multiple of the device's base address alignment), so that ``read_back`` maps
-        once: one map and one release a frame instead of six (measured: 9 against 44 µs on
-        Intel's runtime, 38 against 113 on PoCL).  Grown as a whole when a field needs more."""
-        rows_of = {name: num_triangles if name == "triangles" else num_vertices for name, _, _ in layout}
-        if self._parent is not None and all(rows_of[name] <= self._buffers[name][1] for name in rows_of):
-            return
-        capacities = {}
-        for name, rows in rows_of.items():  # the first allocation as asked; growing, a quarter more
-            kept = -1 if self._parent is None else self._buffers[name][1]
-            capacities[name] = kept if rows <= kept else rows if self._parent is None else int(rows * self.GROWTH)
-        align = max(1, self.queue.device.mem_base_addr_align // 8)
-        offsets, end = {}, 0
-        for name, dtype, shape in layout:
-            offsets[name] = end
-            end += -(-max(capacities[name], 1) * dtype.itemsize * math.prod(shape) // align) * align
-        self._buffers.clear()
-        self._parent = cl.Buffer(self.context, cl.mem_flags.READ_WRITE | cl.mem_flags.ALLOC_HOST_PTR, end)
-        for name, dtype, shape in layout:
-            size = max(capacities[name], 1) * dtype.itemsize * math.prod(shape)
-            self._buffers[name] = (self._parent.get_sub_region(offsets[name], size), capacities[name])
-        self._offsets = offsets
-
-    def read_back(self, num_vertices: int, num_triangles: int) -> dict:
-        """The current generation's output as host arrays (see the class)."""
-        host, events = {}, []
-        if self.mapped:  # one map of the whole allocation; each field a view of it
-            memory, event = cl.enqueue_map_buffer(self.queue, self._parent, cl.map_flags.READ | cl.map_flags.WRITE,
-                                                  0, (self._parent.size,), np.uint8, is_blocking=False)
-            self._maps.append(memory.base)  # the pyopencl MemoryMap
-            for name, dtype, shape in self._layout():
-                rows = num_triangles if name == "triangles" else num_vertices
-                start = self._offsets[name]
-                host[name] = memory[start:start + rows * dtype.itemsize * math.prod(shape)].view(dtype) \
-                    .reshape(rows, *shape)
-            self.read_back_wait_ms = wait_ms([event])
-            return host
-        for name, dtype, shape in self._layout():
-            rows = num_triangles if name == "triangles" else num_vertices
-            buffer, capacity = self._buffers[name]
-            if not rows:
-                host[name] = np.zeros((0, *shape), dtype)
-            elif self.mapped:
-                array, event = cl.enqueue_map_buffer(self.queue, buffer, cl.map_flags.READ | cl.map_flags.WRITE, 0,
-                                                     (rows, *shape), dtype, is_blocking=False)
-                self._maps.append(array.base)  # the pyopencl MemoryMap
-                host[name] = array
-                events.append(event)
-            else:
-                target = self._pinned(name, dtype, shape, capacity)[:rows] if self.pinned \
-                    else np.empty((rows, *shape), dtype)
-                events.append(cl.enqueue_copy(self.queue, target, buffer, is_blocking=False))
-                host[name] = target
-        self.read_back_wait_ms = wait_ms(events) if events else 0.0
-        return host
-
-    def unmap(self) -> None:
-        """Unmap the host views of the last generation (before the device writes the buffers
-        again, as OpenCL asks).  On a CPU device the views still show the buffers' memory, which
-        the next generation overwrites; the buffers live as long as a view of them does."""
-        if self._maps:  # enqueued, not waited for: the queue is in order, so before the writes
-            for memory_map in self._maps:
-                memory_map.release(self.queue)
-            self._maps.clear()
-
-    def _pinned(self, name, dtype, shape, capacity) -> np.ndarray:
-        """The page-locked host array of a field (allocated and mapped once per capacity)."""
-        if name not in self._staging:
-            buffer = cl.Buffer(self.context, cl.mem_flags.READ_WRITE | cl.mem_flags.ALLOC_HOST_PTR,
-                               max(capacity, 1) * dtype.itemsize * math.prod(shape))
-            array, _ = cl.enqueue_map_buffer(self.queue, buffer, cl.map_flags.READ | cl.map_flags.WRITE, 0,
-                                             (max(capacity, 1), *shape), dtype, is_blocking=True)
-            self._staging[name] = (buffer, array)
-        return self._staging[name][1]
-
-    @property
-    def capacity(self) -> tuple[int, int]:
-        """(vertices, triangles) the buffers hold now; (0, 0) before the first ``take``."""
-        return self._capacity
-
-    def reserve(self, num_vertices: int, num_triangles: int) -> None:
-        """Grow the buffers now (as ``take`` would) if they hold fewer than this."""
-        vertices, triangles = self.capacity
-        if (vertices, triangles) != (0, 0) and (num_vertices > vertices or num_triangles > triangles):
-            self.take(max(num_vertices, vertices), max(num_triangles, triangles))  # (a new generation)
-
-    @property
-    def nbytes(self) -> int:
-        if self._parent is not None:
-            return self._parent.size
-        return sum(buffer.size for buffer, _ in self._buffers.values())
-
-
-@dataclass
-class SceneData:
-    """A scene's device data, whatever the tolerance or camera (``Tessellator.scene_data``):
-    parts: (kind, base, count, its device arrays ``upload``) per kind in scene order; objects:
-    (P,) int32 object ids; groups: stage 2's edge groups (``upload_groups``); stats: the
-    scene's edge and mesh counts."""
-
-    scene: Scene
-    sharp_edges: str
-    num_patches: int
-    parts: list
-    objects: cl_array.Array
-    groups: dict
-    stats: dict
-
-
-@dataclass
-class Plan:
-    """Stages 1-3 done for a whole scene: what stages 4-5 need, on the device.
-
-    parts: the kinds' patch ranges and device data (PlanPart); objects: (P,) object ids;
-    factors: (P, 4) final factors (collapsed edges negated: kernels/common.h patch_factors;
-    ``Tessellation.factors`` are their absolute values); vertex_offsets, index_offsets: (P+1,) exclusive scans with
-    the totals last; stats: the scene's counts (see Tessellation.stats); request: what it was
-    planned for.
-    """
-
-    name: str
-    num_patches: int
-    parts: list
-    objects: cl_array.Array
-    factors: cl_array.Array
-    vertex_offsets: cl_array.Array
-    index_offsets: cl_array.Array
-    num_vertices: int | None  # None until settle (plan_on(defer_totals=True))
-    num_indices: int | None
-    stats: dict
-    events: dict
-    started: float
-    request: Request
-    _host: dict = field(default_factory=dict)
-    strip_offsets: cl_array.Array | None = None  # strip patterns' (P+1,) strip index offsets
-    num_strip_indices: int = 0
-    wait_ms: float = 0.0  # host ms blocked waiting for stages 1-3's totals (wall_ms["waits"])
-    _pending: tuple | None = None  # (summary or totals, flags or None, their copies' events) until settle
-
-    @property
-    def settled(self) -> bool:
-        """Whether the totals are known (``settle`` has run)."""
-        return self._pending is None
-
-    def totals_ready(self) -> bool:
-        """Whether the totals' copies have completed (settle would not wait)."""
-        return self._pending is None or all(
-            event.command_execution_status == cl.command_execution_status.COMPLETE for event in self._pending[2])
-
-    def settle(self, ready: bool = False) -> "Plan":
-        """Wait for stage 3's totals and the flags (copied without waiting by plan_on) and
-        fill in num_vertices, num_indices and the counts of ``stats``.  ready: their copies
-        are known to be complete (``totals_ready``), so there is nothing to wait for (a
-        Session frame skips the runtime's wait call then)."""
-        if self._pending is None:
-            return self
-        totals, flags, copies = self._pending
-        if not ready:
-            self.wait_ms += wait_ms(copies)
-        self._pending = None
-        totals = totals.tolist()  # (Python ints, in one call)
-        self.num_vertices, self.num_indices = totals[0], totals[1]
-        check_totals(self.name, self.num_vertices)
-        if flags is None:  # stage 3's summary (Tessellator.stage_counts)
-            culled, saturated = totals[2], totals[3]
-        else:
-            culled = int(np.count_nonzero(flags & FLAG_CULLED))
-            saturated = int(np.count_nonzero(flags & FLAG_SATURATED))
-        self.stats.update(culled=culled, saturated=saturated, vertices=self.num_vertices,
-                          triangles=self.num_indices // 3)
-        return self
-
-    def output_factors(self, first: int, last: int) -> tuple[np.ndarray, np.ndarray | None]:
-        """(factors (n, 4) int32: each edge's segments, real_factors (n, 4) float32 or None when
-        no pattern is fractional) of patches first .. last-1."""
-        factors = np.abs(self.host_factors()[first:last])
-        fixed = [p for p in self.parts if p.pattern.fixed_point]
-        if not fixed:
-            return factors, None
-        from ...patterns.fractional import FIXED_ONE
-        real, whole = factors.astype(np.float32), factors.copy()
-        for part in fixed:
-            lo, hi = max(first, part.base) - first, min(last, part.base + part.count) - first
-            if lo < hi:
-                rows = factors[lo:hi].copy()
-                rows[:, 3] = 0  # slot 3 of a triangle: the SD-2 pattern's hint, not an edge
-                real[lo:hi] = rows / np.float32(FIXED_ONE)
-                whole[lo:hi] = np.where(rows > 0, 2 * ((rows + 2 * FIXED_ONE - 1 + FIXED_ONE) >> 17) - 1, 0)
-        return whole, real
-
-    def host_factors(self) -> np.ndarray:
-        self.enqueue_host_factors()
-        pending = self._host.pop("factors pending", None)
-        if pending is not None:
-            pending.wait()
-        return self._host["factors"]
-
-    def enqueue_host_factors(self) -> None:
-        """Start the factors' copy to the host without waiting (``host_factors`` waits)."""
-        if "factors" not in self._host:
-            self._host["factors"] = np.empty(self.factors.shape, self.factors.dtype)
-            self._host["factors pending"] = cl.enqueue_copy(self.factors.queue, self._host["factors"],
-                                                            self.factors.data, is_blocking=False)
-
-    def _offsets(self, which: str) -> np.ndarray:
-        if which not in self._host:  # read back only when a range is asked of a partial batch
-            self._host[which] = getattr(self, which).get()
-        return self._host[which]
-
-    def vertex_range(self, first: int, last: int) -> tuple[int, int]:
-        if (first, last) == (0, self.num_patches):
-            return 0, self.num_vertices
-        offsets = self._offsets("vertex_offsets")
-        return int(offsets[first]), int(offsets[last])
-
-    def index_range(self, first: int, last: int) -> tuple[int, int]:
-        if (first, last) == (0, self.num_patches):
-            return 0, self.num_indices
-        offsets = self._offsets("index_offsets")
-        return int(offsets[first]), int(offsets[last])
-
-    @property
-    def output_bytes(self) -> int:
-        return self.num_vertices * BYTES_PER_VERTEX + self.num_indices * BYTES_PER_INDEX
-
-    def batch_ranges(self, max_output_bytes: int) -> list[tuple[int, int]]:
-        """Consecutive patch ranges whose vertex + index output fits max_output_bytes each."""
-        if self.output_bytes <= max_output_bytes:
-            return [(0, self.num_patches)]
-        size = (self._offsets("vertex_offsets").astype(np.int64) * BYTES_PER_VERTEX
-                + self._offsets("index_offsets").astype(np.int64) * BYTES_PER_INDEX)  # < 2**40: check_totals
-        per_patch = np.diff(size)
-        if per_patch.max() > max_output_bytes:
-            worst = int(per_patch.argmax())
-            raise OutputTooLarge(f"{self.name}: patch {worst} alone needs {per_patch[worst]} bytes of output, "
-                                 f"more than the cap of {max_output_bytes}; lower max_factor or raise the cap")
-        ranges, first = [], 0
-        while first < self.num_patches:
-            last = int(np.searchsorted(size, size[first] + max_output_bytes, side="right")) - 1
-            last = max(min(last, self.num_patches), first + 1)
-            ranges.append((first, last))
-            first = last
-        return ranges
-
-    def to_host(self) -> "HostPlan":
-        """Read the plan back to the host (picklable), for ``Tessellator.upload_plan`` on
-        another device or process (issue 17)."""
-        return HostPlan(self.name, self.num_patches,
-                        [(p.kind.name, p.pattern.name, p.base, p.count) for p in self.parts],
-                        [p.data["controls"].get() for p in self.parts], self.objects.get(),
-                        self.host_factors(), self._offsets("vertex_offsets"), self._offsets("index_offsets"),
-                        self.num_vertices, self.num_indices, dict(self.stats), self.request,
-                        self.strip_offsets.get() if self.strip_offsets is not None else None,
-                        self.num_strip_indices)
-
-
-@dataclass
-class HostPlan:
-    """A Plan on the host: stages 1-3 done, what stages 4-5 need for any patch range.
-
-    kinds: (kind name, pattern name, base, count) per part; controls: each part's stage-4
-    input, (count, 16, 4) float32 (the Bézier patches, or the PN control points stage 1 made);
-    objects (P,) int32; factors (P, 4) int32, final (crack-free, collapsed edges negated); vertex_offsets and
-    index_offsets (P+1,) uint64 with the totals last; stats as Plan.stats; request: what it
-    was planned for; strip_offsets and num_strip_indices as Plan's (None, 0 without strips).
-    """
-
-    name: str
-    num_patches: int
-    kinds: list
-    controls: list
-    objects: np.ndarray
-    factors: np.ndarray
-    vertex_offsets: np.ndarray
-    index_offsets: np.ndarray
-    num_vertices: int
-    num_indices: int
-    stats: dict
-    request: Request
-    strip_offsets: np.ndarray | None = None  # a strip pattern's (P+1,) strip index offsets (Plan's)
-    num_strip_indices: int = 0
