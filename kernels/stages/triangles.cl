@@ -23,29 +23,42 @@ __kernel void triangles(__global const int4 *factors, __global const ulong *vert
     uint last = first_patch + num_patches;
     if (!batch_fits(index_offsets, last, index_base, capacity))
         return;
-    ulong end = index_offsets[last] / 3, group = get_local_size(0), first_triangle = index_base / 3;
-    ulong at = index_offsets[first_patch] / 3 + get_group_id(0) * group * per_item + get_local_id(0);  /* a triangle */
-    uint p = first_patch, base = 0;
-    ulong patch_start = 0, patch_end = 0;  /* the patch's triangles; none found yet */
+    /* A work-group's triangles are numbered from its first, `start`, in 32 bits (a group's
+     * G * per_item triangles), and a patch's bounds relative to it (patch_start modulo 2^32: a
+     * patch may begin before the group); 64-bit numbers only where a patch is sought. */
+    uint group = (uint)get_local_size(0);
+    ulong end = index_offsets[last] / 3;
+    ulong start = index_offsets[first_patch] / 3 + (ulong)get_group_id(0) * group * per_item;
+    if (start >= end)
+        return;
+    uint stop = (uint)min(end - start, (ulong)group * per_item);
+    __global uint *out = indices + 3 * (start - index_base / 3);
+    uint p = first_patch, base = 0, patch_start = 0, patch_end = 0;  /* the patch's triangles; none found yet */
     int4 f = (int4)(0);
-    int collapsed = 0;
-    for (uint k = 0; k < per_item && at < end; ++k, at += group) {
-        if (at >= patch_end) {
+    int collapsed = 0, direct = 0;
+#ifdef PATTERN_TRIANGLE_AT
+    pattern_triangles grid;
+#endif
+    for (uint r = (uint)get_local_id(0); r < stop; r += group) {
+        if (r >= patch_end) {  /* patch_end >= 1 once found (the patch ends after a triangle >= start) */
+            ulong at = start + r;
             p = patch_end ? patch_after(index_offsets, p, last, 3 * at) : patch_of(index_offsets, p, last, 3 * at);
-            patch_start = index_offsets[p] / 3;
-            patch_end = index_offsets[p + 1] / 3;
+            patch_start = (uint)(index_offsets[p] / 3) - (uint)start;
+            patch_end = (uint)min(index_offsets[p + 1] / 3 - start, (ulong)stop);
             f = patch_factors(factors[p], &collapsed);
             base = (uint)vertex_offsets[p];
-        }
-        uint t = (uint)(at - patch_start);
 #ifdef PATTERN_TRIANGLE_AT
-        uint3 triangle;
-        if (pattern_triangle_at(f, collapsed, t, &triangle)) {
-            vstore3(triangle + base, at - first_triangle, indices);
+            direct = pattern_triangles_of(f, collapsed, &grid);
+#endif
+        }
+        uint t = r - patch_start;
+#ifdef PATTERN_TRIANGLE_AT
+        if (direct) {
+            vstore3(pattern_triangle_in(&grid, t) + base, r, out);
             continue;
         }
 #endif
         if (t == 0)
-            pattern_primitives(f, collapsed, indices + 3 * (at - first_triangle), base);
+            pattern_primitives(f, collapsed, out + (size_t)3 * r, base);
     }
 }
