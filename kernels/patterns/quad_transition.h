@@ -202,9 +202,12 @@ inline uint exact_quotient(uint x, uint m, float m_rcp)
     return r < 0 ? q - 1 : r >= (int)m ? q + 1 : q;
 }
 
-inline uint3 pattern_triangle_in(__private const pattern_triangles *g, uint t)
+/* Triangle t; and *pairs: whether triangle t + 1 is the other half of t's cell (t its (a, b, c), a
+ * row without a collapsed edge's gap after it: t + 1 is then (a, c, d)), with *d = d. */
+inline uint3 pattern_triangle_pair(__private const pattern_triangles *g, uint t, __private int *pairs,
+                                   __private uint *d)
 {
-    int j;
+    int j, plain = 0;
     uint k, x = t - g->first;
     if (t < g->first) {
         j = 0;
@@ -222,15 +225,25 @@ inline uint3 pattern_triangle_in(__private const pattern_triangles *g, uint t)
         s = 2 * (k + g->c3) + 1;
     } else if (j == g->b - 1 && g->c2) {    /* only (a, b, c) slots, less the last cell's on edge 1 */
         s = 2 * k;
-    } else {
+    } else {                                /* every slot but 1 (edge 3) and 2 (A - 1) (edge 1) */
         s = k + (g->c3 && k >= 1);
         s += g->c1 && s >= 2 * (uint)g->a - 2;
+        plain = 1;
     }
     int i = (int)(s >> 1), h = (int)(s & 1);
     /* corners a = (i, j), c = (i + 1, j + 1), and b = (i + 1, j) for h = 0 or d = (i, j + 1) for h = 1 */
     uint a = uniform_index(g->a, g->b, i, j), c = uniform_index(g->a, g->b, i + 1, j + 1);
     uint o = uniform_index(g->a, g->b, i + 1 - h, j + h);
+    *pairs = plain && !h && !(s == 0 && g->c3);  /* slot s + 1 kept: only slot 1 of the odd ones can go */
+    *d = *pairs ? uniform_index(g->a, g->b, i, j + 1) : 0;
     return h ? (uint3)(a, c, o) : (uint3)(a, o, c);
+}
+
+inline uint3 pattern_triangle_in(__private const pattern_triangles *g, uint t)
+{
+    int pairs;
+    uint d;
+    return pattern_triangle_pair(g, t, &pairs, &d);
 }
 
 /* Triangle t of a patch whose triangles are the plain A x B grid (uniform factors): *triangle

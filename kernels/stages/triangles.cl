@@ -39,7 +39,15 @@ __kernel void triangles(__global const int4 *factors, __global const ulong *vert
 #ifdef PATTERN_TRIANGLE_AT
     pattern_triangles grid;
 #endif
+#ifndef TRIANGLE_PAIRS  /* 1: a work-item takes triangles 2 m and 2 m + 1, a cell's two at once where they are */
+#define TRIANGLE_PAIRS 0
+#endif
+#if TRIANGLE_PAIRS
+    for (uint r0 = 2 * (uint)get_local_id(0); r0 < stop; r0 += 2 * group)
+        for (uint r = r0; r < r0 + 2 && r < stop; ++r) {
+#else
     for (uint r = (uint)get_local_id(0); r < stop; r += group) {
+#endif
         if (r >= patch_end) {  /* patch_end >= 1 once found (the patch ends after a triangle >= start) */
             ulong at = start + r;
             p = patch_end ? patch_after(index_offsets, p, last, 3 * at) : patch_of(index_offsets, p, last, 3 * at);
@@ -54,7 +62,18 @@ __kernel void triangles(__global const int4 *factors, __global const ulong *vert
         uint t = r - patch_start;
 #ifdef PATTERN_TRIANGLE_AT
         if (direct) {
+#if TRIANGLE_PAIRS
+            int pairs;
+            uint d;
+            uint3 triangle = pattern_triangle_pair(&grid, t, &pairs, &d);
+            vstore3(triangle + base, r, out);
+            if (r == r0 && pairs && r + 1 < stop) {  /* t + 1: (a, c, d) of the same cell */
+                vstore3((uint3)(triangle.x, triangle.z, d) + base, r + 1, out);
+                break;
+            }
+#else
             vstore3(pattern_triangle_in(&grid, t) + base, r, out);
+#endif
             continue;
         }
 #endif
