@@ -11,14 +11,16 @@ R=$OUT/run2; mkdir -p $R
 P=opt:-DTRIANGLE_PAIRS=1
 timeout 130 python3 bench/gpu_stage45.py --device nvidia --repeat 10 --json $R/stage45.json --variant main rows-prep ../gpu15i-base - --variant branch rows-prep . - --variant pairs rows-prep . $P --variant main-again rows-prep ../gpu15i-base - --variant branch-again rows-prep . - --variant pairs-again rows-prep . $P --variant main-point point ../gpu15i-base - --variant branch-point point . - --variant pairs-point point . $P > $R/stage45.txt 2>&1
 tail -12 $R/stage45.txt
-for o in "" -DTRIANGLE_PAIRS=1; do (cd ../gpu15i-base; [ -n "$o" ] && cd ../gpu15i; CLTESS_BUILD_OPTIONS="$o" timeout 50 ncu --clock-control none -k 'regex:^triangles$' -c 1 --set full --import-source no -f -o $R/tri${o:+_pairs} python3 bench/ncu_stage45.py --repeat 1 --kernels triangles) > $R/ncu_tri${o:+_pairs}_log.txt 2>&1; done
-timeout 50 ncu --clock-control none -k 'regex:^triangles$' -c 1 --set full --import-source no -f -o $R/tri_branch python3 bench/ncu_stage45.py --repeat 1 --kernels triangles > $R/ncu_tri_branch_log.txt 2>&1
+N="ncu --clock-control none -k regex:^triangles$ -c 1 --set full --import-source no -f"
+(cd ../gpu15i-base && PYTHONPATH=/tmp/site:$PWD timeout 50 $N -o $R/tri python3 bench/ncu_stage45.py --repeat 1 --kernels triangles) > $R/ncu_tri_log.txt 2>&1
+timeout 50 $N -o $R/tri_branch python3 bench/ncu_stage45.py --repeat 1 --kernels triangles > $R/ncu_tri_branch_log.txt 2>&1
+CLTESS_BUILD_OPTIONS=-DTRIANGLE_PAIRS=1 timeout 50 $N -o $R/tri_pairs python3 bench/ncu_stage45.py --repeat 1 --kernels triangles > $R/ncu_tri_pairs_log.txt 2>&1
 for n in tri tri_branch tri_pairs; do ncu -i $R/$n.ncu-rep --page details --print-units base --print-details all > $R/${n}_details.txt 2>&1; ncu -i $R/$n.ncu-rep --page source --csv --print-source sass > $R/${n}_sass.csv 2>&1; done
 S="tea_table double_torus killeroo herd spheres star_field model_zoo elephant"
 for o in "" -DTRIANGLE_PAIRS=1; do echo "options '$o'"; CLTESS_BUILD_OPTIONS="$o" timeout 45 python3 bench/frame_hashes.py --device nvidia $S; done > $R/hashes.txt 2>&1
 grep -v "^ *$" $R/hashes.txt | tail -20
 T="tests/test_triangle_at.py tests/test_quad_grid_cells.py tests/test_triangles_mirror.py tests/test_work_points.py tests/test_recorded_frames.py tests/test_work_auto.py tests/test_frame_capacity.py"
-CLTESS_DEVICE=nvidia timeout 110 python3 -m pytest -o addopts="" -q -p no:cacheprovider $T tests/test_unit_normal.py tests/test_projected.py tests/test_vertices.py tests/contracts tests/test_crack_offsets.py tests/test_fused_offsets.py tests/test_session.py tests/test_frame_host.py tests/test_poles.py tests/test_pattern_normals.py > $R/gpu_tests.txt 2>&1
+CLTESS_DEVICE=nvidia timeout 130 python3 -m pytest -o addopts="" -q -p no:cacheprovider $T tests/test_unit_normal.py tests/test_projected.py tests/test_vertices.py tests/contracts tests/test_crack_offsets.py tests/test_fused_offsets.py tests/test_session.py tests/test_frame_host.py tests/test_poles.py tests/test_pattern_normals.py > $R/gpu_tests.txt 2>&1
 tail -2 $R/gpu_tests.txt
 CLTESS_BUILD_OPTIONS=-DTRIANGLE_PAIRS=1 CLTESS_DEVICE=nvidia timeout 60 python3 -m pytest -o addopts="" -q -p no:cacheprovider $T > $R/gpu_tests_pairs.txt 2>&1
 tail -2 $R/gpu_tests_pairs.txt
