@@ -84,24 +84,9 @@ __kernel void prepared_points(__global const kind_patch *restrict prepared, __gl
 #endif
 #define LINE_MAX_PATCHES 64
 #define LINE_STAGED (LINE_GROUP * (LINE_CHUNK + 1))
-#ifndef LINE_WORDS  /* 1: the write-out of positions, normals and uv word by word (see prepared_rows) */
-#define LINE_WORDS 0
-#endif
-#ifndef LINE_VECTORS  /* 1: a point staged as a float4 position, a float4 normal and a float2 uv */
-#define LINE_VECTORS 0
-#endif
-#if LINE_WORDS && LINE_VECTORS
-#error "LINE_WORDS and LINE_VECTORS are two stagings: one at a time"
-#endif
-#if LINE_WORDS  /* the components' rows 11 banks apart, so that the 3 lanes reading a point's x, y, z
-                 * (or the 2 its u, v) fall in distinct banks */
-#define LINE_SKEW 11
-#else
-#define LINE_SKEW 0
-#endif
 
 /* A point's position, normal and uv (its domain point's u, v) to the staging slot. */
-inline void stage_point(__local float (*staged)[LINE_STAGED + LINE_SKEW], uint slot, float3 position, float3 normal, float3 x)
+inline void stage_point(__local float (*staged)[LINE_STAGED], uint slot, float3 position, float3 normal, float3 x)
 {
     staged[0][slot] = position.x;
     staged[1][slot] = position.y;
@@ -111,15 +96,6 @@ inline void stage_point(__local float (*staged)[LINE_STAGED + LINE_SKEW], uint s
     staged[5][slot] = normal.z;
     staged[6][slot] = x.x;
     staged[7][slot] = x.y;
-}
-
-/* The same as vectors: 3 local stores a point instead of 8, and 3 local loads in the write-out. */
-inline void stage_vectors(__local float4 *staged_position, __local float4 *staged_normal, __local float2 *staged_uv,
-                          uint slot, float3 position, float3 normal, float3 x)
-{
-    staged_position[slot] = (float4)(position, 0.0f);
-    staged_normal[slot] = (float4)(normal, 0.0f);
-    staged_uv[slot] = x.xy;
 }
 
 __kernel void line_constants(__global uint *constants)
@@ -138,14 +114,7 @@ void prepared_rows(__global const kind_patch *restrict prepared, __global const 
                    __global int *patch_ids, __global int *object_ids)
 {
     __local uint row_first[LINE_MAX_PATCHES + 1];
-#if LINE_VECTORS
-    __local float4 staged_position[LINE_STAGED], staged_normal[LINE_STAGED];
-    __local float2 staged_uv[LINE_STAGED];
-#define STAGE(slot, position, normal, x) stage_vectors(staged_position, staged_normal, staged_uv, slot, position, normal, x)
-#else
-    __local float staged[8][LINE_STAGED + LINE_SKEW];  /* position, normal, uv of each staged point */
-#define STAGE(slot, position, normal, x) stage_point(staged, slot, position, normal, x)
-#endif
+    __local float staged[8][LINE_STAGED];  /* position, normal, uv of each staged point */
     __local ulong line_at[LINE_GROUP];     /* output slot of each work-item's first staged point */
     __local int line_count[LINE_GROUP], line_patch[LINE_GROUP], line_object[LINE_GROUP];
     __local int round_length;
@@ -230,13 +199,13 @@ void prepared_rows(__global const kind_patch *restrict prepared, __global const 
                 for (int s = 0; s < staging; ++s) {
                     patch = prepared[p - first_patch];
                     edge_point(&patch, f, collapsed, edge, k + s, &x, &position, &normal);
-                    STAGE(own + (uint)s, position, normal, x);
+                    stage_point(staged, own + (uint)s, position, normal, x);
                 }
             } else {
                 for (int s = 0; s < staging; ++s) {
                     patch = prepared[p - first_patch];
                     row_point(&patch, f, collapsed, row, k + s, forward_differencing, &walk, &x, &position, &normal);
-                    STAGE(own + (uint)s, position, normal, x);
+                    stage_point(staged, own + (uint)s, position, normal, x);
                 }
             }
             line_at[item] = at + (ulong)k;
@@ -244,45 +213,6 @@ void prepared_rows(__global const kind_patch *restrict prepared, __global const 
             line_patch[item] = (int)p;
             line_object[item] = staging ? group_object[q] : 0;
             barrier(CLK_LOCAL_MEM_FENCE);
-#if LINE_WORDS
-            /* Word by word: a warp's store is 32 consecutive floats of positions (and of normals), then
-             * of uv: lane `item` writes word w = item + 32 m of the staged points' components, point
-             * n = w / 3 (uv: w / 2), component c, stepped without a division (32 = 3 * 10 + 2). */
-            uint n = item / 3, c = item % 3;
-            for (uint w = item; w < 3 * LINE_GROUP * LINE_CHUNK; w += LINE_GROUP) {
-                uint from = n / LINE_CHUNK, s = n % LINE_CHUNK, slot = from * (LINE_CHUNK + 1) + s;
-                if ((int)s < line_count[from]) {
-                    ulong word = 3 * (line_at[from] + s) + c;
-                    positions[word] = staged[c][slot];
-                    normals[word] = staged[3 + c][slot];
-                }
-                n += LINE_GROUP / 3;
-                c += LINE_GROUP % 3;
-                if (c >= 3) {
-                    c -= 3;
-                    ++n;
-                }
-            }
-            for (uint w = item; w < 2 * LINE_GROUP * LINE_CHUNK; w += LINE_GROUP) {
-                uint from = (w / 2) / LINE_CHUNK, s = (w / 2) % LINE_CHUNK, slot = from * (LINE_CHUNK + 1) + s;
-                if ((int)s < line_count[from])
-                    uv[2 * (line_at[from] + s) + w % 2] = staged[6 + w % 2][slot];
-            }
-            for (uint t = item; t < LINE_GROUP * LINE_CHUNK; t += LINE_GROUP) {  /* the ids, a point a work-item */
-                uint from = t / LINE_CHUNK, s = t % LINE_CHUNK;
-                if ((int)s < line_count[from]) {
-                    patch_ids[line_at[from] + s] = line_patch[from];
-                    object_ids[line_at[from] + s] = line_object[from];
-                }
-            }
-#elif LINE_VECTORS
-            for (uint t = item; t < LINE_GROUP * LINE_CHUNK; t += LINE_GROUP) {  /* consecutive t: one line's points */
-                uint from = t / LINE_CHUNK, s = t % LINE_CHUNK, slot = from * (LINE_CHUNK + 1) + s;
-                if ((int)s < line_count[from])
-                    put_vertex(out, line_at[from] + s, staged_position[slot].xyz, staged_normal[slot].xyz,
-                               staged_uv[slot], line_patch[from], line_object[from]);
-            }
-#else
             for (uint t = item; t < LINE_GROUP * LINE_CHUNK; t += LINE_GROUP) {  /* consecutive t: one line's points */
                 uint from = t / LINE_CHUNK, s = t % LINE_CHUNK, slot = from * (LINE_CHUNK + 1) + s;
                 if ((int)s < line_count[from])
@@ -291,7 +221,6 @@ void prepared_rows(__global const kind_patch *restrict prepared, __global const 
                                (float3)(staged[3][slot], staged[4][slot], staged[5][slot]),
                                (float2)(staged[6][slot], staged[7][slot]), line_patch[from], line_object[from]);
             }
-#endif
             barrier(CLK_LOCAL_MEM_FENCE);
         }
     }

@@ -1,7 +1,7 @@
 /* Stage 5 a work-item per output triangle (issue 15, for GPUs): consecutive work-items write
  * consecutive triangles (coalesced stores).  As stages/vertex_points.cl: a work-group of G
  * work-items owns G * per_item consecutive triangles of the batch, in step k its work-item l
- * writes triangle k G + l of them, and it finds a triangle's patch over index_offsets only when
+ * writes triangles 2 (k G + l) and 2 (k G + l) + 1 of them, and it finds a triangle's patch over index_offsets only when
  * the patch changes (64-bit divisions by 3 only then): its first by patch_of (common.h), the next
  * ones by patch_after, galloping from the patch it leaves.  A pattern with
  * random access to a regular patch's triangles (PATTERN_TRIANGLE_AT, pattern_triangle_at) gives
@@ -13,7 +13,14 @@
  * "Stage 5 by triangle"), 0.136 ms with its corners by uniform_grid_index and patch_after.
  * Staging a step's triangles in local memory and writing them as consecutive words (whole
  * sectors) was slower there: 0.184 ms, 0.205 with a run of 16 consecutive triangles per
- * work-item (bench/RESULTS.md, "Issue 15: stage 5's triangle math").
+ * work-item (bench/RESULTS.md, "Issue 15: stage 5's triangle math").  Stage 5 is issue-bound
+ * (Nsight Compute on the H200: 77% of issue slots, 207 warp instructions per 32 triangles), so
+ * a work-item now takes two consecutive triangles, a cell's (a, b, c) and (a, c, d) from one
+ * pattern_triangle_pair where they are one cell's (else each alone); a patch's grid and row layout
+ * are made once per patch (pattern_triangles_of), the row by a float reciprocal, and a group's
+ * triangles are numbered in 32 bits: 133 instructions per 32 triangles, 0.133 -> 0.115 ms on the
+ * H200 at uniform level 16 (bench/RESULTS.md, "Issue 15: stage 4's write-out and stage 5's
+ * instructions (session 10, branch gpu15i)").
  * The batch is patches first_patch .. first_patch + num_patches - 1; work-items past its last
  * triangle stop. */
 __kernel void triangles(__global const int4 *factors, __global const ulong *vertex_offsets,
@@ -39,45 +46,35 @@ __kernel void triangles(__global const int4 *factors, __global const ulong *vert
 #ifdef PATTERN_TRIANGLE_AT
     pattern_triangles grid;
 #endif
-#ifndef TRIANGLE_PAIRS  /* 1: a work-item takes triangles 2 m and 2 m + 1, a cell's two at once where they are */
-#define TRIANGLE_PAIRS 0
-#endif
-#if TRIANGLE_PAIRS
-    for (uint r0 = 2 * (uint)get_local_id(0); r0 < stop; r0 += 2 * group)
-        for (uint r = r0; r < r0 + 2 && r < stop; ++r) {
-#else
-    for (uint r = (uint)get_local_id(0); r < stop; r += group) {
-#endif
-        if (r >= patch_end) {  /* patch_end >= 1 once found (the patch ends after a triangle >= start) */
-            ulong at = start + r;
-            p = patch_end ? patch_after(index_offsets, p, last, 3 * at) : patch_of(index_offsets, p, last, 3 * at);
-            patch_start = (uint)(index_offsets[p] / 3) - (uint)start;
-            patch_end = (uint)min(index_offsets[p + 1] / 3 - start, (ulong)stop);
-            f = patch_factors(factors[p], &collapsed);
-            base = (uint)vertex_offsets[p];
+    for (uint r0 = 2 * (uint)get_local_id(0); r0 < stop; r0 += 2 * group) {
+        for (uint r = r0; r < r0 + 2 && r < stop; ++r) {  /* triangles r0 and r0 + 1 */
+            if (r >= patch_end) {  /* patch_end >= 1 once found (the patch ends after a triangle >= start) */
+                ulong at = start + r;
+                p = patch_end ? patch_after(index_offsets, p, last, 3 * at) : patch_of(index_offsets, p, last, 3 * at);
+                patch_start = (uint)(index_offsets[p] / 3) - (uint)start;
+                patch_end = (uint)min(index_offsets[p + 1] / 3 - start, (ulong)stop);
+                f = patch_factors(factors[p], &collapsed);
+                base = (uint)vertex_offsets[p];
 #ifdef PATTERN_TRIANGLE_AT
-            direct = pattern_triangles_of(f, collapsed, &grid);
+                direct = pattern_triangles_of(f, collapsed, &grid);
 #endif
-        }
-        uint t = r - patch_start;
-#ifdef PATTERN_TRIANGLE_AT
-        if (direct) {
-#if TRIANGLE_PAIRS
-            int pairs;
-            uint d;
-            uint3 triangle = pattern_triangle_pair(&grid, t, &pairs, &d);
-            vstore3(triangle + base, r, out);
-            if (r == r0 && pairs && r + 1 < stop) {  /* t + 1: (a, c, d) of the same cell */
-                vstore3((uint3)(triangle.x, triangle.z, d) + base, r + 1, out);
-                break;
             }
-#else
-            vstore3(pattern_triangle_in(&grid, t) + base, r, out);
+            uint t = r - patch_start;
+#ifdef PATTERN_TRIANGLE_AT
+            if (direct) {
+                int pairs;
+                uint d;
+                uint3 triangle = pattern_triangle_pair(&grid, t, &pairs, &d);
+                vstore3(triangle + base, r, out);
+                if (r == r0 && pairs && r + 1 < stop) {  /* t + 1: (a, c, d) of the same cell */
+                    vstore3((uint3)(triangle.x, triangle.z, d) + base, r + 1, out);
+                    break;
+                }
+                continue;
+            }
 #endif
-            continue;
+            if (t == 0)
+                pattern_primitives(f, collapsed, out + (size_t)3 * r, base);
         }
-#endif
-        if (t == 0)
-            pattern_primitives(f, collapsed, out + (size_t)3 * r, base);
     }
 }
