@@ -163,7 +163,11 @@ inline void grid_cells(__global uint *out, uint *count, uint base, pattern_grid 
 
 /* pattern_triangle_at in two parts, so that stage 5 (stages/triangles.cl) makes the per-patch part
  * once per patch and not once per triangle: pattern_triangles_of, a patch's grid and the layout of
- * its kept slots (0 for a patch without random access); pattern_triangle_in, triangle t of it. */
+ * its kept slots (0 for a patch without random access); pattern_triangle_in, triangle t of it, and
+ * pattern_triangle_pair, which also gives triangle t + 1 where it is the other half of t's cell.
+ * With the row by a reciprocal and three corners a triangle: stage 5 of uniform level 16 on the
+ * H200 0.133 -> 0.120 ms, 0.115 with a cell's two triangles a work-item (bench/RESULTS.md,
+ * "Issue 15: stage 4's write-out and stage 5's instructions (session 10, branch gpu15i)"). */
 typedef struct {
     int a, b;          /* the grid's steps A, B */
     uint c0, c1, c2, c3;  /* collapsed edges */
