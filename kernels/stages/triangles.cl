@@ -1,9 +1,9 @@
 /* Stage 5 a work-item per output triangle (issue 15, for GPUs): consecutive work-items write
  * consecutive triangles (coalesced stores).  As stages/vertex_points.cl: a work-group of G
  * work-items owns G * per_item consecutive triangles of the batch, in step k its work-item l
- * writes triangles 2 (k G + l) and 2 (k G + l) + 1 of them, and it finds a triangle's patch over index_offsets only when
- * the patch changes (64-bit divisions by 3 only then): its first by patch_of (common.h), the next
- * ones by patch_after, galloping from the patch it leaves.  A pattern with
+ * writes triangles 2 (k G + l) and 2 (k G + l) + 1 of them, and it finds a triangle's patch over
+ * index_offsets only when the patch changes (64-bit divisions by 3 only then): its first by
+ * patch_of (common.h), the next ones by patch_after, galloping from the patch it leaves.  A pattern with
  * random access to a regular patch's triangles (PATTERN_TRIANGLE_AT, pattern_triangle_at) gives
  * triangle t directly; any other patch is emitted whole by the work-item of its triangle 0 with
  * pattern_primitives, as stages/indices.cl does.  Either way the bits of stages/indices.cl.
