@@ -90,14 +90,18 @@ inline uint pattern_grid_index(pattern_grid g, int2 point)
  * edge 3: 2A + B + (B - j) <= 2A + 2B - 1), so the remainder is the number itself.  Stage 5 of
  * uniform level 16 on PoCL spent two thirds of its time in the ring's cells before this
  * (bench/RESULTS.md, "PoCL's stages, session 7"). */
-inline uint uniform_grid_index(pattern_grid g, int2 point)
+inline uint uniform_index(int a, int b, int i, int j)
 {
-    int a = g.core.x, b = g.core.y, i = point.x, j = point.y;
     if (j == 0) return (uint)i;                      /* ring_index(f, 0, i) */
     if (i == a) return (uint)(a + j);                /* ring_index(f, 1, j) */
     if (j == b) return (uint)(2 * a + b - i);        /* ring_index(f, 2, A - i) */
     if (i == 0) return (uint)(2 * a + 2 * b - j);    /* ring_index(f, 3, B - j) */
     return (uint)(2 * a + 2 * b) + (uint)(j - 1) * (uint)(a - 1) + (uint)(i - 1);
+}
+
+inline uint uniform_grid_index(pattern_grid g, int2 point)
+{
+    return uniform_index(g.core.x, g.core.y, point.x, point.y);
 }
 
 /* pattern_grid_index, by uniform_grid_index where the grid is uniform. */
@@ -155,6 +159,97 @@ inline void grid_cells(__global uint *out, uint *count, uint base, pattern_grid 
     }
 }
 
+#define PATTERN_TRIANGLE_AT 1
+
+/* pattern_triangle_at in two parts, so that stage 5 (stages/triangles.cl) makes the per-patch part
+ * once per patch and not once per triangle: pattern_triangles_of, a patch's grid and the layout of
+ * its kept slots (0 for a patch without random access); pattern_triangle_in, triangle t of it, and
+ * pattern_triangle_pair, which also gives triangle t + 1 where it is the other half of t's cell.
+ * With the row by a reciprocal and three corners a triangle: stage 5 of uniform level 16 on the
+ * H200 0.133 -> 0.120 ms, 0.115 with a cell's two triangles a work-item (bench/RESULTS.md,
+ * "Issue 15: stage 4's write-out and stage 5's instructions (session 10, branch gpu15i)"). */
+typedef struct {
+    int a, b;          /* the grid's steps A, B */
+    uint c0, c1, c2, c3;  /* collapsed edges */
+    uint first;        /* row 0's triangles */
+    uint middle;       /* each of rows 1 .. B - 2's triangles */
+    uint inner;        /* rows 1 .. B - 2's triangles together */
+    float middle_rcp;  /* 1 / middle (the row by one multiplication: exact_quotient) */
+} pattern_triangles;
+
+inline int pattern_triangles_of(int4 f, int collapsed, __private pattern_triangles *g)
+{
+    pattern_grid grid = quad_grid(f);
+    int a_steps = grid.core.x, b_steps = grid.core.y;
+    g->a = a_steps;
+    g->b = b_steps;
+    g->c0 = collapsed & 1;
+    g->c1 = (collapsed >> 1) & 1;
+    g->c2 = (collapsed >> 2) & 1;
+    g->c3 = (collapsed >> 3) & 1;
+    g->middle = 2 * (uint)a_steps - g->c1 - g->c3;  /* a row that touches neither edge 0 nor edge 2 */
+    g->first = (g->c0 ? 0 : (uint)a_steps - g->c1) + (b_steps == 1 && g->c2 ? 0 : (uint)a_steps - g->c3);
+    g->inner = (uint)max(b_steps - 2, 0) * g->middle;
+    g->middle_rcp = g->middle ? 1.0f / (float)g->middle : 0.0f;
+    return grid.uniform;
+}
+
+/* x / m for m > 0, exactly, by one float multiplication where x < 2^20: (float)x is exact, and
+ * x * (1 / m) (even with a division of 2.5 ulp) is within 0.4 of x / m, so the truncated q is
+ * x / m or one off, and the remainder's sign puts it right.  Larger x by the integer division. */
+inline uint exact_quotient(uint x, uint m, float m_rcp)
+{
+    if (x >= (1u << 20))
+        return x / m;
+    uint q = (uint)((float)x * m_rcp);
+    int r = (int)x - (int)(q * m);
+    return r < 0 ? q - 1 : r >= (int)m ? q + 1 : q;
+}
+
+/* Triangle t; and *pairs: whether triangle t + 1 is the other half of t's cell (t its (a, b, c), a
+ * row without a collapsed edge's gap after it: t + 1 is then (a, c, d)), with *d = d. */
+inline uint3 pattern_triangle_pair(__private const pattern_triangles *g, uint t, __private int *pairs,
+                                   __private uint *d)
+{
+    int j, plain = 0;
+    uint k, x = t - g->first;
+    if (t < g->first) {
+        j = 0;
+        k = t;
+    } else if (x < g->inner) {
+        uint q = exact_quotient(x, g->middle, g->middle_rcp);
+        j = 1 + (int)q;
+        k = x - q * g->middle;
+    } else {
+        j = g->b - 1;
+        k = x - g->inner;
+    }
+    uint s;
+    if (j == 0 && g->c0) {                  /* only (a, c, d) slots, less the first cell's on edge 3 */
+        s = 2 * (k + g->c3) + 1;
+    } else if (j == g->b - 1 && g->c2) {    /* only (a, b, c) slots, less the last cell's on edge 1 */
+        s = 2 * k;
+    } else {                                /* every slot but 1 (edge 3) and 2 (A - 1) (edge 1) */
+        s = k + (g->c3 && k >= 1);
+        s += g->c1 && s >= 2 * (uint)g->a - 2;
+        plain = 1;
+    }
+    int i = (int)(s >> 1), h = (int)(s & 1);
+    /* corners a = (i, j), c = (i + 1, j + 1), and b = (i + 1, j) for h = 0 or d = (i, j + 1) for h = 1 */
+    uint a = uniform_index(g->a, g->b, i, j), c = uniform_index(g->a, g->b, i + 1, j + 1);
+    uint o = uniform_index(g->a, g->b, i + 1 - h, j + h);
+    *pairs = plain && !h && !(s == 0 && g->c3);  /* slot s + 1 kept: only slot 1 of the odd ones can go */
+    *d = *pairs ? uniform_index(g->a, g->b, i, j + 1) : 0;
+    return h ? (uint3)(a, c, o) : (uint3)(a, o, c);
+}
+
+inline uint3 pattern_triangle_in(__private const pattern_triangles *g, uint t)
+{
+    int pairs;
+    uint d;
+    return pattern_triangle_pair(g, t, &pairs, &d);
+}
+
 /* Triangle t of a patch whose triangles are the plain A x B grid (uniform factors): *triangle
  * its local vertex numbers, as grid_cells emits them (cells row by row, each (a, b, c) then
  * (a, c, d), less those grid_cells leaves out on collapsed edges).  In row j the triangle slots
@@ -165,44 +260,14 @@ inline void grid_cells(__global uint *out, uint *count, uint base, pattern_grid 
  * uniform_grid_index (no "% ring"; the same numbers as grid_cell's): stage 5 of uniform level 16
  * on the H100 took 0.146 ms against 0.216 by pattern_grid_index (bench/RESULTS.md, "Issue 15:
  * stage 5's triangle math (session 8, branch gpu15f)").  Stage 5 a work-item per triangle
- * (stages/triangles.cl) uses it; tests/test_triangle_at.py checks it against grid_cells for
- * every collapsed mask. */
-#define PATTERN_TRIANGLE_AT 1
+ * (stages/triangles.cl) uses the two parts; tests/test_triangle_at.py checks this against
+ * grid_cells for every collapsed mask. */
 inline int pattern_triangle_at(int4 f, int collapsed, uint t, __private uint3 *triangle)
 {
-    pattern_grid g = quad_grid(f);
-    if (!g.uniform)
+    pattern_triangles g;
+    if (!pattern_triangles_of(f, collapsed, &g))
         return 0;
-    int a_steps = g.core.x, b_steps = g.core.y;
-    uint c0 = collapsed & 1, c1 = (collapsed >> 1) & 1, c2 = (collapsed >> 2) & 1, c3 = (collapsed >> 3) & 1;
-    uint middle = 2 * (uint)a_steps - c1 - c3;  /* a row that touches neither edge 0 nor edge 2 */
-    uint first = (c0 ? 0 : (uint)a_steps - c1) + (b_steps == 1 && c2 ? 0 : (uint)a_steps - c3);
-    int j;
-    uint k;
-    if (t < first) {
-        j = 0;
-        k = t;
-    } else if (t - first < (uint)max(b_steps - 2, 0) * middle) {
-        j = 1 + (int)((t - first) / middle);
-        k = (t - first) % middle;
-    } else {
-        j = b_steps - 1;
-        k = t - first - (uint)max(b_steps - 2, 0) * middle;
-    }
-    uint s;
-    if (j == 0 && c0) {                  /* only (a, c, d) slots, less the first cell's on edge 3 */
-        s = 2 * (k + c3) + 1;
-    } else if (j == b_steps - 1 && c2) { /* only (a, b, c) slots, less the last cell's on edge 1 */
-        s = 2 * k;
-    } else {
-        s = k + (c3 && k >= 1);
-        s += c1 && s >= 2 * (uint)a_steps - 2;
-    }
-    int i = (int)(s >> 1);
-    uint a = uniform_grid_index(g, (int2)(i, j)), c = uniform_grid_index(g, (int2)(i + 1, j + 1));
-    uint b = (s & 1) ? c : uniform_grid_index(g, (int2)(i + 1, j));
-    uint d = (s & 1) ? uniform_grid_index(g, (int2)(i, j + 1)) : c;
-    *triangle = (uint3)(a, b, d);
+    *triangle = pattern_triangle_in(&g, t);
     return 1;
 }
 
