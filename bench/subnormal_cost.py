@@ -9,7 +9,8 @@ H200").  Each kernel runs a dependent chain of 4,096 operations per work-item (6
 on a value that stays subnormal (1e-40) or normal (1e-30): ``x * one``, ``x / one``, ``x + zero``,
 ``sqrt(x)`` squared (a subnormal operand of the root, a subnormal product), and ``(x * c) * 1e10``
 with c = 1e-10 on x = 1e-30 (a subnormal product of normal operands; the "normal" column starts
-at 1e-20).  ``one``, ``zero`` and ``c`` come from a buffer, so that the compiler cannot fold them.  Reported: process CPU ms per kernel and
+at 1e-20); and the same chains on x = 0 (a zero dividend: NVIDIA's division takes its slow path
+there).  ``one``, ``zero`` and ``c`` come from a buffer, so that the compiler cannot fold them.  Reported: process CPU ms per kernel and
 value, the minimum over ``--rounds`` interleaved rounds (both values launched in each), and the
 ratio subnormal / normal.
 """
@@ -55,7 +56,7 @@ def main(argv=None) -> int:
     out = cl.Buffer(context, cl.mem_flags.READ_WRITE, 4 * count)
     constants = np.array([1.0, 1.0, 0.0, 0.0, 1.0e-10], np.float32)
     k = cl.Buffer(context, cl.mem_flags.READ_ONLY | cl.mem_flags.COPY_HOST_PTR, hostbuf=constants)
-    starts = {"subnormal": np.float32(1e-40), "normal": np.float32(1e-30)}
+    starts = {"subnormal": np.float32(1e-40), "normal": np.float32(1e-30), "zero": np.float32(0.0)}
     best, final = {}, {}
     for _ in range(args.rounds):
         for op in range(len(OPS)):
@@ -69,11 +70,13 @@ def main(argv=None) -> int:
                 final[op, label] = float(result[0])  # where the chain ended: still (sub)normal?
                 best[op, label] = min(best.get((op, label), ms), ms)
     print(f"{tessellator.device.platform.name.strip()}: CPU ms for {count} x 4096 dependent operations")
-    print("| operation | normal x (1e-30; op 5: 1e-20) | subnormal x (1e-40; op 5: 1e-30) | ratio | x at the end (normal, subnormal) |")
-    print("|---|---|---|---|---|")
+    print("| operation | normal x (1e-30; op 5: 1e-20) | subnormal x (1e-40; op 5: 1e-30) | ratio | x = 0 | ratio | "
+          "x at the end (normal, subnormal) |")
+    print("|---|---|---|---|---|---|---|")
     for op, name in enumerate(OPS):
         normal, subnormal = best[op, "normal"], best[op, "subnormal"]
-        print(f"| {name} | {normal:.0f} | {subnormal:.0f} | {subnormal / normal:.2f} | "
+        zero = best[op, "zero"]
+        print(f"| {name} | {normal:.0f} | {subnormal:.0f} | {subnormal / normal:.2f} | {zero:.0f} | {zero / normal:.2f} | "
               f"{final[op, 'normal']:.3g}, {final[op, 'subnormal']:.3g} |")
     return 0
 
