@@ -8,7 +8,8 @@ instruction.
 Uniform level 16 as ``bench/cpu_stages.py`` (``--copies`` teapots of 32 patches, every edge factor
 16), stages 1-3 planned once by the engine; then the named stage's per-patch kernel, built like
 cpu_stages.py does (from ``--kernels``, default this tree's kernels/, with ``-D`` ``--define``s),
-is launched ``--launches`` times, each waited, after ``--warm`` launches that are not timed.
+is launched ``--launches`` times, each waited, after ``--warm`` launches that are not timed
+(``--local``: with that work-group size; by default the runtime picks, as in the engine).
 Prints the launches' process CPU ms (min, median: ``getrusage`` of every thread), the output's
 hash (blake2b of the stage's arrays after the last launch: compare two builds' bits), and the
 marks ``perf_stages: start``/``end`` with ``time.monotonic()`` so that ``perf report --time``
@@ -47,6 +48,7 @@ def main(argv=None) -> int:
     parser.add_argument("--warm", type=int, default=2, help="launches before the timed ones")
     parser.add_argument("--kernels", help="a kernels/ folder to build from (default this tree's)")
     parser.add_argument("--define", nargs="*", default=[], help="-D names for the build")
+    parser.add_argument("--local", type=int, help="work-group size (default: the runtime's choice, as the engine)")
     args = parser.parse_args(argv)
 
     tessellator = Tessellator(args.device, work="patch")
@@ -68,13 +70,14 @@ def main(argv=None) -> int:
         out = [cl_array.empty(queue, (plan.num_indices,), np.uint32)]
         arguments = (plan.factors.data, plan.vertex_offsets.data, plan.index_offsets.data, np.uint32(0),
                      np.uint32(patches), np.uint64(0), np.uint64(plan.num_indices), out[0].data)
+    local = (args.local,) if args.local else None
     for _ in range(args.warm):
-        kernel(queue, per_patch, None, *arguments).wait()
+        kernel(queue, per_patch, local, *arguments).wait()
     cpu = []
     print(f"perf_stages: start {time.monotonic():.3f}", file=sys.stderr, flush=True)
     for _ in range(args.launches):
         started = cpu_stages.cpu_seconds()
-        kernel(queue, per_patch, None, *arguments).wait()
+        kernel(queue, per_patch, local, *arguments).wait()
         cpu.append((cpu_stages.cpu_seconds() - started) * 1e3)
     print(f"perf_stages: end {time.monotonic():.3f}", file=sys.stderr, flush=True)
     hashed = hashlib.blake2b(digest_size=8)
