@@ -54,13 +54,13 @@ inline float3 unit_or_zero(float3 a)
 }
 
 /* --- PoCL's builtins inline (issue 15, the CPU line) ---------------------------------------------
- * PoCL 3.0 on x86-64 (LLVM 14; it defines POCL_DEVICE_ADDRESS_BITS) keeps cross, dot, length, vstore3
- * and vstore2 of float3/float2 out of line: in stage 4 (stages/vertices.cl) every vertex made 8
- * calls, each a handful of instructions, and, every xmm register being the caller's to save on
- * x86-64, each call spilled the live float4s to the stack around it.  Sampled by perf, the
- * builtins' own bodies held 24% of stage 4's CPU time and the spills and reloads around the calls
- * much of the rest (bench/RESULTS.md, "Issue 15: stage 4 on the CPU under perf (session 10, branch
- * `cpu15f`)").  Here they are spelled out as PoCL's library computes them (its code in the
+ * PoCL 3.0 on x86-64 (LLVM 14; it defines POCL_DEVICE_ADDRESS_BITS) keeps cross, dot, length,
+ * vstore3 and vstore2 of float3/float2 out of line: in stage 4 (stages/vertices.cl) every vertex
+ * made 8 calls, each a handful of instructions, and, every xmm register being the caller's to save
+ * on x86-64, each call spilled the live float4s to the stack around it.  Sampled by perf, the
+ * builtins' own bodies held a quarter of stage 4's CPU time and the spills and reloads around the
+ * calls much of the rest (bench/RESULTS.md, "Issue 15: stage 4 on the CPU under perf (session 10,
+ * branch `cpu15f`)").  Here they are spelled out as PoCL's library computes them (its code in the
  * kernels' shared objects: the same operations in the same order, so the same bits;
  * tests/test_unit_normal.py compares them with the builtins bit for bit on every device), so
  * that the compiler inlines them.  Elsewhere they are the builtins, as before.  Stage 4's hot

@@ -127,7 +127,7 @@ ALWAYS_INLINE void grid_cell(__global uint *out, uint *count, uint base, pattern
  * at out[3 count + 6 n ..] (so that a CPU compiler can unroll and vectorise it; stage 5 on
  * CPUs: bench/RESULTS.md, "Issue 15: CPU stage bandwidth" and "PoCL's stages, session 7"). */
 ALWAYS_INLINE void grid_cells(__global uint *out, uint *count, uint base, pattern_grid g, int collapsed,
-                       int i0, int i1, int j0, int j1)
+                              int i0, int i1, int j0, int j1)
 {
     uint ring = (uint)(g.f.s0 + g.f.s1 + g.f.s2 + g.f.s3), inner = (uint)(g.core.x - 1);
     for (int j = j0; j < j1; ++j) {
