@@ -2,18 +2,20 @@
 for a sampling profiler (``perf record -e cpu-clock``) to attribute the CPU time instruction by
 instruction.
 
-    perf record -e cpu-clock -F 2000 -o stage4.data -- \\
-        python bench/perf_stages.py --device pocl --stage 4 --launches 20 [--kernels DIR] [--define NAME ...]
+    POCL_CACHE_DIR=/tmp/pc perf record -k CLOCK_MONOTONIC -e cpu-clock -F 4000 -g -o stage4.data -- \\
+        python bench/perf_stages.py --device pocl --stage 4 --launches 12 [--local 64] [--kernels DIR] [--define NAME ...]
+    perf report -i stage4.data --time START,END --no-children --sort dso,sym --stdio -g none
 
 Uniform level 16 as ``bench/cpu_stages.py`` (``--copies`` teapots of 32 patches, every edge factor
 16), stages 1-3 planned once by the engine; then the named stage's per-patch kernel, built like
 cpu_stages.py does (from ``--kernels``, default this tree's kernels/, with ``-D`` ``--define``s),
 is launched ``--launches`` times, each waited, after ``--warm`` launches that are not timed
-(``--local``: with that work-group size; by default the runtime picks, as in the engine).
+(``--local``: with that work-group size; by default none, so the runtime picks: PoCL took 4,000
+here, where the engine names 64 on PoCL, programs.py ``names_local_size``).
 Prints the launches' process CPU ms (min, median: ``getrusage`` of every thread), the output's
 hash (blake2b of the stage's arrays after the last launch: compare two builds' bits), and the
-marks ``perf_stages: start``/``end`` with ``time.monotonic()`` so that ``perf report --time``
-can cut the build away.  On PoCL set ``POCL_CACHE_DIR`` to a folder of your own so that the
+marks ``perf_stages: start``/``end`` with ``time.monotonic()`` (START, END above; perf's clock
+when recorded with ``-k CLOCK_MONOTONIC``) so that ``perf report --time`` can cut the build away.  On PoCL set ``POCL_CACHE_DIR`` to a folder of your own so that the
 kernel's shared object (``.../vertices.so``) stays there for ``perf report``/``perf annotate``;
 the samples in it are the kernel's (``_pocl_kernel_vertices_workgroup``, its work-group function).
 """
@@ -48,7 +50,7 @@ def main(argv=None) -> int:
     parser.add_argument("--warm", type=int, default=2, help="launches before the timed ones")
     parser.add_argument("--kernels", help="a kernels/ folder to build from (default this tree's)")
     parser.add_argument("--define", nargs="*", default=[], help="-D names for the build")
-    parser.add_argument("--local", type=int, help="work-group size (default: the runtime's choice, as the engine)")
+    parser.add_argument("--local", type=int, help="work-group size (default: none, the runtime's choice)")
     args = parser.parse_args(argv)
 
     tessellator = Tessellator(args.device, work="patch")

@@ -1,4 +1,8 @@
-"""Diagnostic build (not the engine): stage 4 with surface_normal returning flags of subnormal intermediates."""
+"""Diagnostic build (not the engine): stage 4 with surface_normal returning flags of subnormal intermediates.
+
+Record of the run behind subnormal-intermediates-stage4.txt (paths as they were): the diagnostic tree is
+this branch's kernels/ copied to /tmp/cpu15f/diag/kernels with diag-subnormal-flags.diff applied; run
+from the worktree with PYTHONPATH=$PWD: python diag_subnormal_flags.py 1000 [pocl|intel]."""
 import sys, numpy as np, pyopencl as cl, pyopencl.array as cl_array
 from pathlib import Path
 sys.path.insert(0, "/work/wt/cpu15f/bench")
