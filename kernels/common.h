@@ -53,6 +53,65 @@ inline float3 unit_or_zero(float3 a)
     return len > 0.0f ? a / len : (float3)(0.0f);
 }
 
+/* --- PoCL's builtins inline (issue 15, the CPU line) ---------------------------------------------
+ * PoCL 3.0 on x86-64 (LLVM 14; it defines POCL_DEVICE_ADDRESS_BITS) keeps cross, dot, length,
+ * vstore3 and vstore2 of float3/float2 out of line: in stage 4 (stages/vertices.cl) every vertex
+ * made 8 calls, each a handful of instructions, and, every xmm register being the caller's to save
+ * on x86-64, each call spilled the live float4s to the stack around it.  Sampled by perf, the
+ * builtins' own bodies held a quarter of stage 4's CPU time and the spills and reloads around the
+ * calls much of the rest (bench/RESULTS.md, "Issue 15: stage 4 on the CPU under perf (session 10,
+ * branch `cpu15f`)").  Here they are spelled out as PoCL's library computes them (its code in the
+ * kernels' shared objects: the same operations in the same order, so the same bits;
+ * tests/test_unit_normal.py compares them with the builtins bit for bit on every device), so
+ * that the compiler inlines them.  Elsewhere they are the builtins, as before.  Stage 4's hot
+ * path uses them (kinds/bezier.h tangent_cross, unit_or's length, put_vertex's stores). */
+#if defined(POCL_DEVICE_ADDRESS_BITS) && defined(__x86_64__) && !defined(CLTESS_BUILTIN_FORMS)
+#define CLTESS_POCL_FORMS 1
+/* (a.x b.x + a.y b.y) + a.z b.z, PoCL's dot(float3) */
+ALWAYS_INLINE float dot3f(float3 a, float3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+/* PoCL's cross(float3), component by component */
+ALWAYS_INLINE float3 cross3(float3 a, float3 b)
+{
+    return (float3)(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+/* PoCL's length(float3): sqrt of the dot, the vector scaled by 2^86 first (and the root by 2^-86
+ * after) where the dot is below FLT_MIN, by 2^-65 (and 2^65) where it is +inf.  The root is
+ * clang's __builtin_sqrtf, the correctly rounded vsqrtss that PoCL's length and sqrt run, inline
+ * (PoCL's sqrt is out of line too). */
+ALWAYS_INLINE float length3(float3 a)
+{
+    float s = dot3f(a, a);
+    if (s < FLT_MIN) {
+        float3 b = a * 0x1.0p86f;
+        return __builtin_sqrtf(dot3f(b, b)) * 0x1.0p-86f;
+    }
+    if (s == INFINITY) {
+        float3 b = a * 0x1.0p-65f;
+        return __builtin_sqrtf(dot3f(b, b)) * 0x1.0p65f;
+    }
+    return __builtin_sqrtf(s);
+}
+/* vstore3 / vstore2: the components stored one by one */
+ALWAYS_INLINE void store3(float3 v, ulong at, __global float *out)
+{
+    out[3 * at] = v.x;
+    out[3 * at + 1] = v.y;
+    out[3 * at + 2] = v.z;
+}
+ALWAYS_INLINE void store2(float2 v, ulong at, __global float *out)
+{
+    out[2 * at] = v.x;
+    out[2 * at + 1] = v.y;
+}
+#else
+#define CLTESS_POCL_FORMS 0
+#define dot3f dot
+#define cross3 cross
+#define length3 length
+#define store3 vstore3
+#define store2 vstore2
+#endif
+
 /* --- division without a zero dividend (issue 15, NVIDIA) ---------------------------------------
  * NVIDIA's correctly rounded division (div.rn.f32: MUFU.RCP, a refinement and FCHK) calls a slow
  * path, out of line, wherever FCHK finds an operand outside its fast range: a zero dividend is
@@ -97,6 +156,9 @@ inline float normal_length(float3 n)
     float sum = fma(qc, qc, fma(qb, qb, qa * qa));
     return m * sqrt(sum);
 }
+#elif CLTESS_POCL_FORMS
+#define CLTESS_SPELLED_LENGTH 2
+inline float normal_length(float3 n) { return length3(n); }
 #else
 #define CLTESS_SPELLED_LENGTH 0
 inline float normal_length(float3 n) { return length(n); }
@@ -379,9 +441,9 @@ typedef struct {
 inline void put_vertex(vertex_out out, ulong at, float3 position, float3 normal, float2 uv,
                        int patch, int object)
 {
-    vstore3(position, at, out.positions);
-    vstore3(normal, at, out.normals);
-    vstore2(uv, at, out.uv);
+    store3(position, at, out.positions);  /* vstore3, vstore2 (inline on PoCL: above) */
+    store3(normal, at, out.normals);
+    store2(uv, at, out.uv);
     out.patch_ids[at] = patch;
     out.object_ids[at] = object;
 }

@@ -86,9 +86,9 @@ inline float3 tangent_cross(float3 p, float4 s_u, float4 s_v, int *ok)
 {
     float3 t_u = s_u.xyz - s_u.w * p;
     float3 t_v = s_v.xyz - s_v.w * p;
-    float3 n = cross(t_u, t_v);
-    float scale = dot(t_u, t_u) + dot(t_v, t_v);
-    *ok = dot(n, n) > NORMAL_DEGENERATE * NORMAL_DEGENERATE * scale * scale;
+    float3 n = cross3(t_u, t_v);  /* cross, dot (inline on PoCL: common.h) */
+    float scale = dot3f(t_u, t_u) + dot3f(t_v, t_v);
+    *ok = dot3f(n, n) > NORMAL_DEGENERATE * NORMAL_DEGENERATE * scale * scale;
     return n;
 }
 
@@ -125,7 +125,7 @@ inline float3 limit_normal(const float4 b[16], float u, float v, float4 s, float
     float4 ds_u = d_u * s_uu + d_v * s_uv, ds_v = d_u * s_uv + d_v * s_vv;
     float3 dt_u = ds_u.xyz - ds_u.w * p - s_u.w * dp;
     float3 dt_v = ds_v.xyz - ds_v.w * p - s_v.w * dp;
-    return cross(dt_u, t_v) + cross(t_u, dt_v);
+    return cross3(dt_u, t_v) + cross3(t_u, dt_v);
 }
 
 /* Unit normal at (u, v), given B, p = B.xyz / B.w (projected), B_u, B_v there: t_u x t_v, or at
@@ -144,7 +144,7 @@ ALWAYS_INLINE float3 surface_normal(const float4 b[16], float u, float v, float4
     float3 n = tangent_cross(p, s_u, s_v, &ok);
     if (!ok) {
         float3 limit = limit_normal(b, u, v, s, p, s_u, s_v);
-        if (dot(limit, limit) > dot(n, n)) {
+        if (dot3f(limit, limit) > dot3f(n, n)) {
             n = limit;
         } else {
             surface_eval(b, u + NORMAL_SHIFT * (0.5f - u), v + NORMAL_SHIFT * (0.5f - v), &s, &s_u, &s_v);

@@ -171,3 +171,24 @@ def stop_background() -> None:
             started.process.wait()
     for folder in _FOLDER:
         shutil.rmtree(folder, ignore_errors=True)
+
+
+def report_scenarios(names: list[str], out_dir: Path) -> bool:
+    """Both passes on the scenarios ``names`` (started together, into ``out_dir / pass``), as
+    test_oclgrind.py's test_no_oclgrind_reports reads them: a line per pass and scenario, "OK" or
+    its first problems (not finished, Oclgrind's reports), and a line per pass with its exit code
+    and seconds; for a session's record of the scenarios its change reaches (e.g.
+    bench/results/cpu15f-2core/oclgrind_cpu15f.py).  Whether every scenario was OK."""
+    assert all(name in NAMES for name in names), [name for name in names if name not in NAMES]
+    print("scenarios:", names, flush=True)
+    started = {name: start(name, out_dir / name, names) for name in PASSES}
+    clean = True
+    for name, pass_started in started.items():
+        began = time.time()
+        run = finish(pass_started)
+        for scenario in names:
+            problems = ([] if scenario in run.results else ["did not finish"]) + run.reports.get(scenario, [])
+            clean = clean and not problems
+            print(name, scenario, "OK" if not problems else problems[:3], flush=True)
+        print(name, "exit", run.returncode, f"{time.time() - began:.0f} s", flush=True)
+    return clean
