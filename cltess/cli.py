@@ -482,14 +482,17 @@ def _check_emit(args) -> None:
         raise UsageError("--emit by-level needs --pattern semi-uniform (the levels' templates are that pattern's)")
 
 
-def _prepare_scene(args):
+def _prepare_scene(args, loaded=None):
     """Load, orient and check the scene; turn a relative --eps into a distance.  Returns (scene,
-    orientation report or None, the tolerance as the summary shows it)."""
+    orientation report or None, the tolerance as the summary shows it).  ``loaded()`` is called
+    once the scene is read, before the rest."""
     _check_emit(args)
     from cltess.io import load_scene
     from cltess.limits import eps_below_float32
 
     scene = load_scene(args.scene, crease_angle=args.crease_angle)
+    if loaded is not None:
+        loaded()
     orientation = None
     if args.orient:
         from cltess.orient import orient_scene
@@ -568,16 +571,23 @@ def cmd_tessellate(args) -> int:
     if args.uv == "seam" and output.suffix.lower() not in (".ply", ".obj", ".npz"):
         raise UsageError(f"{output}: --uv seam can be written to .ply, .obj or .npz only")
     preview = _check_preview(args.preview, args.scene) if args.preview else None
-    # The scene first, then the device, one after the other.  (Opening OpenCL on a thread while
-    # the scene loads was tried: Python's warning filters are one global list, and the text
-    # parser's catch_warnings(simplefilter("error")) turned pyopencl's compiler-output warning on
-    # the other thread into an exception, which pyopencl's cache reports as a KeyError.)
-    scene, orientation, eps_text = _prepare_scene(args)
-    device = pick_device(args.device)
-
     from cltess.pipeline import Tessellator  # lazy: builds OpenCL programs
 
-    tessellator = Tessellator(device=device)
+    # The scene is read first; then OpenCL starts on a thread (platforms, device, context: C
+    # code) while the scene is oriented and checked on this one.  Not while the scene is read:
+    # Python's warning filters are one global list, and the text parser's
+    # catch_warnings(simplefilter("error")) (io/text.py, where long double is not x87) turned
+    # pyopencl's compiler-output warning on the other thread into an exception (a KeyError from
+    # pyopencl's cache).  Orientation and the checks change no warning filter.
+    opening = []
+    try:
+        scene, orientation, eps_text = _prepare_scene(args, lambda: opening.append(
+            _in_background(lambda: Tessellator(device=pick_device(args.device)))))
+    except BaseException:
+        for thread in opening:
+            thread.join()  # nothing left running; the scene's error is the one reported
+        raise
+    tessellator = opening[0].result()
     mesh_options = {"sharp_edges": args.sharp_edges} if scene.meshes else {}
     mesh_options.update(_level_options(args, scene))
     def before_writing(plan):
@@ -639,9 +649,34 @@ def cmd_tessellate(args) -> int:
               "curve, so the mesh may crack there; --sharp-edges straight or average keeps it closed",
               file=sys.stderr)
     if not args.quiet:
-        print(format_summary(result.stats, result.stage_ms, scene=args.scene, device=device.name.strip(),
+        print(format_summary(result.stats, result.stage_ms, scene=args.scene, device=tessellator.device.name.strip(),
                              tolerance=eps_text, output=output if preview is None else f"{output}, {preview}"))
     return EXIT_OK
+
+
+class _in_background:
+    """``make()`` on a thread started now; ``result()`` joins it and returns its value or
+    raises its exception (``join()``: waits only)."""
+
+    def __init__(self, make):
+        self._value, self._error = None, None
+        self._thread = threading.Thread(target=self._run, args=(make,), name="cltess-opencl", daemon=True)
+        self._thread.start()
+
+    def _run(self, make):
+        try:
+            self._value = make()
+        except BaseException as error:  # handed to result()
+            self._error = error
+
+    def join(self) -> None:
+        self._thread.join()
+
+    def result(self):
+        self._thread.join()
+        if self._error is not None:
+            raise self._error
+        return self._value
 
 
 def cmd_tessellate_frames(args) -> int:
