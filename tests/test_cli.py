@@ -368,6 +368,38 @@ def test_a_scene_error_is_reported_before_a_device_error(capsys, tmp_path, fake_
     assert list(tmp_path.iterdir()) == []
 
 
+def test_a_scene_check_error_is_reported_before_a_device_error_and_no_thread_is_left(capsys, tmp_path, scene_file,
+                                                                                     fake_pipeline):
+    """OpenCL opens on a thread once the scene is read: a scene that reads but fails a later
+    check (--pixels without a camera) is the error reported (exit 2), not the device's, and the
+    thread has ended."""
+    import threading
+
+    code, _, err = run(capsys, "tessellate", scene_file, "--pixels", "0.5", "--device", "no-such-gpu",
+                       "-o", tmp_path / "out.ply")
+    assert code == 2
+    assert_clean_error(err, "camera")
+    assert "no-such-gpu" not in err
+    assert not [t for t in threading.enumerate() if t.name == "cltess-opencl"]
+
+
+def test_opencl_starts_after_the_scene_is_read(capsys, tmp_path, scene_file, fake_pipeline, monkeypatch):
+    """The OpenCL thread starts only once the scene is read (the text parser's warning filters
+    are global: io/text.py), and its tessellator is the one used."""
+    import cltess.io
+
+    events = []
+    read = cltess.io.load_scene
+    monkeypatch.setattr(cltess.io, "load_scene", lambda *a, **k: (read(*a, **k), events.append("read"))[0])
+    opened = FakeTessellator.__init__
+    monkeypatch.setattr(FakeTessellator, "__init__", lambda self, device=None: (
+        events.append("opened"), opened(self, device))[1])
+    code, _, err = run(capsys, "tessellate", scene_file, "--eps", "1e-3", "-o", tmp_path / "out.ply")
+    assert code == 0, err
+    assert events == ["read", "opened"]
+    assert fake_pipeline.calls[0]["device"] is not None
+
+
 def test_interrupt_during_export_leaves_no_file(capsys, tmp_path, scene_file, fake_pipeline, monkeypatch):
     def interrupted(fd):
         raise KeyboardInterrupt
