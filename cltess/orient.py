@@ -21,9 +21,7 @@ which side is out).  Non-manifold groups (more than two patch-edges) constrain n
 from __future__ import annotations
 
 from collections import deque
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from typing import NamedTuple
 
 import numpy as np
 
@@ -55,10 +53,12 @@ class Orientation:
         return {"flipped_patches": self.flipped, "orientation_conflicts": self.conflicts}
 
 
-def orientation_flips(groups, num_patches: int, edges_per_patch: int, sums: "VolumeSums") -> tuple[np.ndarray, Orientation]:
+def orientation_flips(groups, num_patches: int, edges_per_patch: int, points: np.ndarray,
+                      grid: np.ndarray) -> tuple[np.ndarray, Orientation]:
     """(flip (P,) bool, report): which patches to reverse so that every shared edge is run in
-    opposite directions and every component has a positive signed volume (``sums``: each
-    patch's ``volume_sums``)."""
+    opposite directions and every component has a positive signed volume.  points (3, P, S): S
+    samples of each patch (x, y, z rows); grid (T, 3): the triangles over a patch's samples,
+    facing as the patch does."""
     sizes = groups.group_sizes
     pair_start = groups.group_start[:-1][sizes == 2]
     a, b = groups.members[pair_start].astype(np.int64), groups.members[pair_start + 1].astype(np.int64)
@@ -67,7 +67,7 @@ def orientation_flips(groups, num_patches: int, edges_per_patch: int, sums: "Vol
     p, q, differ = p[use], q[use], (groups.flipped[a] == groups.flipped[b])[use]
     flip, component, report = _parity_components(num_patches, p, q, differ)
 
-    volume, size = _signed_volumes(sums, component, np.where(flip, -1.0, 1.0), report.components)
+    volume, size = _signed_volumes(points, grid, component, np.where(flip, -1.0, 1.0), report.components)
     inward = volume < -FLAT * size ** 3  # a flat piece has no outside: left as it is
     flip ^= inward[component]
     report.flipped = int(flip.sum())
@@ -152,40 +152,22 @@ def _parity_walk(num_patches: int, p: np.ndarray, q: np.ndarray, differ: np.ndar
     return flip, component, report
 
 
-class VolumeSums(NamedTuple):
-    """Per patch (``volume_sums``): sum of det(a, b, d), (3, P) sums of a x b + b x d + d x a
-    and of a + b + d over its triangles (a, b, d), (3, P) the least and greatest sample; and
-    the triangle corners of a patch (3 T)."""
-
-    determinant: np.ndarray
-    twice_area: np.ndarray
-    corner_sum: np.ndarray
-    low: np.ndarray
-    high: np.ndarray
-    corners: float
-
-
-def volume_sums(points: np.ndarray, grid: np.ndarray) -> VolumeSums:
-    """The per-patch sums ``_signed_volumes`` combines.  points (3, P, S): S samples of each
-    patch (x, y, z rows); grid (T, 3): the triangles over a patch's samples, facing as the patch
-    does.  Coordinates are taken about the scene's centre first (against cancellation far from
-    the origin)."""
-    points = points - points.reshape(3, -1).mean(axis=1)[:, None, None]
-    return VolumeSums(*_patch_sums(points, grid), points.min(axis=2), points.max(axis=2), 3.0 * len(grid))
-
-
-def _signed_volumes(sums: VolumeSums, component: np.ndarray, sign: np.ndarray, count: int):
+def _signed_volumes(points: np.ndarray, grid: np.ndarray, component: np.ndarray, sign: np.ndarray,
+                    count: int):
     """((count,) signed volume, (count,) bounding-box diagonal) per component.  The volume: the
-    sum over its patches' triangles (a, b, d) (each patch's times its sign) of det(a - c, b - c,
-    d - c) / 6 = (det(a, b, d) - c . (a x b + b x d + d x a)) / 6, c the centroid of the
-    component's triangle corners.  The sums are taken per patch (``volume_sums``), then per
-    component (bincount)."""
-    determinant, twice_area, corner_sum = sums.determinant * sign, sums.twice_area * sign, sums.corner_sum
+    sum over its patches' triangles (a, b, d) (``grid`` over ``points``, each patch's times its
+    sign) of det(a - c, b - c, d - c) / 6 = (det(a, b, d) - c . (a x b + b x d + d x a)) / 6, c
+    the centroid of the component's triangle corners.  Coordinates are taken about the scene's
+    centre first (against cancellation far from the origin).  The sums are taken per patch,
+    then per component (bincount)."""
+    points = points - points.reshape(3, -1).mean(axis=1)[:, None, None]
+    determinant, twice_area, corner_sum = _patch_sums(points, grid)
+    determinant, twice_area = determinant * sign, twice_area * sign
 
     def per_component(values):
         return np.bincount(component, values, minlength=count)
 
-    corners = per_component(np.full(len(component), sums.corners))
+    corners = per_component(np.full(len(component), 3.0 * len(grid)))
     centre = np.stack([per_component(corner_sum[axis]) for axis in range(3)], axis=1)
     centre /= np.maximum(corners, 1)[:, None]
     area = np.stack([per_component(twice_area[axis]) for axis in range(3)], axis=1)
@@ -194,8 +176,8 @@ def _signed_volumes(sums: VolumeSums, component: np.ndarray, sign: np.ndarray, c
     present, start = np.unique(component[order], return_index=True)
     low, high = np.full((count, 3), np.inf), np.full((count, 3), -np.inf)
     if len(order):
-        low[present] = np.minimum.reduceat(sums.low.T[order], start)
-        high[present] = np.maximum.reduceat(sums.high.T[order], start)
+        low[present] = np.minimum.reduceat(points.min(axis=2).T[order], start)
+        high[present] = np.maximum.reduceat(points.max(axis=2).T[order], start)
     size = np.linalg.norm(np.where(np.isfinite(high - low), high - low, 0), axis=1)
     return (per_component(determinant) - (centre * area).sum(axis=1)) / 6, size
 
@@ -262,8 +244,8 @@ def orient_scene(scene: Scene) -> tuple[Scene, Orientation]:
             continue
         corners = mesh.vertices[mesh.faces].astype(np.float32)
         groups, _ = mesh_edge_groups(corners)
-        flip, part = orientation_flips(groups, mesh.num_faces, 3, volume_sums(
-            corners.astype(np.float64).transpose(2, 0, 1), np.array([[0, 1, 2]])))
+        flip, part = orientation_flips(groups, mesh.num_faces, 3, corners.astype(np.float64).transpose(2, 0, 1),
+                                       np.array([[0, 1, 2]]))
         _add(report, part)
         if flip.any():
             faces = mesh.faces.copy()
@@ -285,11 +267,8 @@ def _bezier_flips(scene: Scene) -> tuple[np.ndarray, Orientation]:
     from .surfaces import bezier
 
     def make():
-        # The volume sums on a thread while this one groups the edges: both are NumPy, which
-        # releases the GIL (bench/RESULTS.md, "Issue 15: the cold 30k-patch PLY (session 10)").
-        with ThreadPoolExecutor(1) as pool:
-            sums = pool.submit(lambda: volume_sums(*_bezier_samples(scene.patches)))
-            flip, report = orientation_flips(scene_edge_groups(scene), len(scene.patches), 4, sums.result())
+        flip, report = orientation_flips(scene_edge_groups(scene), len(scene.patches), 4,
+                                         *_bezier_samples(scene.patches))
         return {"flip": flip, "counts": np.array([report.flipped, report.components, report.conflicts])}
 
     sources = [__file__, adjacency.__file__, bezier.__file__, scene_module.__file__]
