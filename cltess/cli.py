@@ -483,21 +483,15 @@ def _check_emit(args) -> None:
 
 
 def _prepare_scene(args, loaded=None):
-    """Load, orient and check the scene; turn a relative --eps into a distance.  Returns (scene,
-    orientation report or None, the tolerance as the summary shows it).  ``loaded()`` is called
-    once the scene is read, before the rest."""
+    """Load, check and orient the scene; turn a relative --eps into a distance.  Returns (scene,
+    orientation report or None, the tolerance as the summary shows it).  ``loaded(scene)`` is
+    called once the scene is read and checked, before it is oriented (orientation changes no
+    bounding box, camera or coordinate magnitude the checks look at)."""
     _check_emit(args)
     from cltess.io import load_scene
     from cltess.limits import eps_below_float32
 
     scene = load_scene(args.scene, crease_angle=args.crease_angle)
-    if loaded is not None:
-        loaded()
-    orientation = None
-    if args.orient:
-        from cltess.orient import orient_scene
-
-        scene, orientation = orient_scene(scene)
     if args.pixels is not None and scene.camera is None and getattr(args, "camera_path", None) is None:
         raise UsageError(f"{args.scene}: --pixels needs a camera in the scene (use a .json scene "
                          "with a \"camera\", or give --eps)")
@@ -518,6 +512,13 @@ def _prepare_scene(args, loaded=None):
         if too_fine:
             print(f"{PROG}: warning: {args.scene}: {too_fine}", file=sys.stderr)
     tolerance = eps_text if args.eps is not None else f"{args.pixels:g} px"
+    if loaded is not None:
+        loaded(scene)
+    orientation = None
+    if args.orient:
+        from cltess.orient import orient_scene
+
+        scene, orientation = orient_scene(scene)
     return scene, orientation, tolerance
 
 
@@ -573,23 +574,28 @@ def cmd_tessellate(args) -> int:
     preview = _check_preview(args.preview, args.scene) if args.preview else None
     from cltess.pipeline import Tessellator  # lazy: builds OpenCL programs
 
-    # The scene is read first; then OpenCL starts on a thread (platforms, device, context: C
-    # code) while the scene is oriented and checked on this one.  Not while the scene is read:
-    # Python's warning filters are one global list, and the text parser's
+    # The scene is read and checked first; then OpenCL starts on a thread (platforms, device,
+    # context, and the programs the plan will want) while this one orients the scene.  Not while
+    # the scene is read: Python's warning filters are one global list, and the text parser's
     # catch_warnings(simplefilter("error")) (io/text.py, where long double is not x87) turned
     # pyopencl's compiler-output warning on the other thread into an exception (a KeyError from
-    # pyopencl's cache).  Orientation and the checks change no warning filter.
-    opening = []
+    # pyopencl's cache).  Orientation changes no warning filter.
+    opening, options = [], {}
+
+    def loaded(scene):
+        options.update({"sharp_edges": args.sharp_edges} if scene.meshes else {})
+        options.update(_level_options(args, scene))
+        options.update(eps=args.eps, pixels=args.pixels, max_factor=args.max_factor,
+                       pattern=PATTERN_CHOICES[args.pattern], max_level=args.max_level, emit=EMIT_CHOICES[args.emit])
+        opening.append(_in_background(lambda: _opened(Tessellator(device=pick_device(args.device)), scene, options)))
+
     try:
-        scene, orientation, eps_text = _prepare_scene(args, lambda: opening.append(
-            _in_background(lambda: Tessellator(device=pick_device(args.device)))))
+        scene, orientation, eps_text = _prepare_scene(args, loaded)
     except BaseException:
         for thread in opening:
             thread.join()  # nothing left running; the scene's error is the one reported
         raise
     tessellator = opening[0].result()
-    mesh_options = {"sharp_edges": args.sharp_edges} if scene.meshes else {}
-    mesh_options.update(_level_options(args, scene))
     def before_writing(plan):
         """After stages 1-3, before anything big exists: warn, estimate, refuse."""
         _warn_saturated(int(plan.stats.get("saturated", 0)), args)
@@ -620,9 +626,7 @@ def cmd_tessellate(args) -> int:
             on_plan=before_writing, progress=progress,
             on_batch=(lambda batch: drawing.add(batch.positions, batch.triangles, normals=batch.normals))
             if drawing else None,
-            eps=args.eps, pixels=args.pixels, max_factor=args.max_factor, forward_differencing=not args.no_fd,
-            pattern=PATTERN_CHOICES[args.pattern], max_level=args.max_level, emit=EMIT_CHOICES[args.emit],
-            verify=args.verify, **mesh_options)
+            forward_differencing=not args.no_fd, verify=args.verify, **options)
     if drawing is not None:
         from cltess.render import write_png
 
@@ -652,6 +656,19 @@ def cmd_tessellate(args) -> int:
         print(format_summary(result.stats, result.stage_ms, scene=args.scene, device=tessellator.device.name.strip(),
                              tolerance=eps_text, output=output if preview is None else f"{output}, {preview}"))
     return EXIT_OK
+
+
+def _opened(tessellator, scene, options: dict):
+    """The tessellator, with the programs ``plan(scene, **options)`` will want already built: a
+    warm-up on the OpenCL thread (``Tessellator.compose``, about 0.09 s for the 30k-patch
+    scene); whatever fails here fails again in the plan, which reports it."""
+    from cltess.request import Request
+
+    try:
+        tessellator.compose(scene, Request.of(**options))
+    except Exception:  # noqa: BLE001 (the plan composes again and reports it)
+        pass
+    return tessellator
 
 
 class _in_background:

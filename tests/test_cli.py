@@ -394,10 +394,31 @@ def test_opencl_starts_after_the_scene_is_read(capsys, tmp_path, scene_file, fak
     opened = FakeTessellator.__init__
     monkeypatch.setattr(FakeTessellator, "__init__", lambda self, device=None: (
         events.append("opened"), opened(self, device))[1])
+    monkeypatch.setattr(FakeTessellator, "compose", lambda self, scene, request: events.append(request), raising=False)
     code, _, err = run(capsys, "tessellate", scene_file, "--eps", "1e-3", "-o", tmp_path / "out.ply")
     assert code == 0, err
-    assert events == ["read", "opened"]
-    assert fake_pipeline.calls[0]["device"] is not None
+    assert events[:2] == ["read", "opened"] and len(events) == 3
+    call = fake_pipeline.calls[0]
+    assert call["device"] is not None
+    # the programs built on the thread are those of the plan's request
+    assert events[2].tolerance.eps == call["eps"] == 1e-3 and events[2].pattern == call["pattern"]
+
+
+def test_a_failing_program_warm_up_leaves_the_error_to_the_plan(capsys, tmp_path, scene_file, fake_pipeline,
+                                                                 monkeypatch):
+    """cli._opened builds the plan's programs on the OpenCL thread; what fails there is met
+    again, and reported, by the plan."""
+    def compose(self, scene, request):
+        raise RuntimeError("build failed")
+
+    monkeypatch.setattr(FakeTessellator, "compose", compose, raising=False)
+    code, _, err = run(capsys, "tessellate", scene_file, "--eps", "1e-3", "-o", tmp_path / "out.ply")
+    assert code == 0, err
+    assert len(fake_pipeline.calls) == 1
+    fake_pipeline.result = RuntimeError("build failed")
+    code, _, err = run(capsys, "tessellate", scene_file, "--eps", "1e-3", "-o", tmp_path / "out2.ply")
+    assert code == 1
+    assert_clean_error(err, "build failed")
 
 
 def test_interrupt_during_export_leaves_no_file(capsys, tmp_path, scene_file, fake_pipeline, monkeypatch):
