@@ -198,15 +198,16 @@ class _Numbers:
             return None
         if not decimal.EXTENDED:
             return _Numbers._of_fromstring(data, commas)
-        # Outputs sized for the most tokens the bytes can hold: pages no token reaches are never
-        # touched (no copy of per-piece parts, and no fresh memory beyond the results).
+        # Outputs sized for the most tokens the bytes can hold: pages no token reaches are
+        # never touched (no copy of per-piece parts, and no fresh memory beyond the results).
         most = len(data) // 2 + 1
         values, start, lengths = np.empty(most), np.empty(most, np.int64), np.empty(most, np.int64)
         per_line, commas_per_line = [], []
         count = 0
-        # The pieces on threads, one per core: NumPy releases the GIL in nearly all of a piece's
-        # work (two cores: ~0.6 of one's time on the 30k-patch scene, bench/RESULTS.md "Issue
-        # 15: the cold 30k-patch PLY (session 10)"); their results copied out in order.
+        # The pieces on threads, one per core, their results copied out in file order: NumPy
+        # releases the GIL in nearly all of a piece's work (the 30k-patch scene on two cores:
+        # 0.255 s median against 0.301 on one, bench/RESULTS.md "Issue 15: the cold 30k-patch
+        # PLY (session 10, branch `ply15d`)").
         with ThreadPoolExecutor(min(PARSE_THREADS, os.cpu_count() or 1)) as pool:
             for part in pool.map(lambda bounds: _piece(data, *bounds, commas), _pieces(data)):
                 if part is None:
