@@ -482,19 +482,16 @@ def _check_emit(args) -> None:
         raise UsageError("--emit by-level needs --pattern semi-uniform (the levels' templates are that pattern's)")
 
 
-def _prepare_scene(args):
-    """Load, orient and check the scene; turn a relative --eps into a distance.  Returns (scene,
-    orientation report or None, the tolerance as the summary shows it)."""
+def _prepare_scene(args, loaded=None):
+    """Load, check and orient the scene; turn a relative --eps into a distance.  Returns (scene,
+    orientation report or None, the tolerance as the summary shows it).  ``loaded(scene)`` is
+    called once the scene is read and checked, before it is oriented (orientation changes no
+    bounding box, camera or coordinate magnitude the checks look at)."""
     _check_emit(args)
     from cltess.io import load_scene
     from cltess.limits import eps_below_float32
 
     scene = load_scene(args.scene, crease_angle=args.crease_angle)
-    orientation = None
-    if args.orient:
-        from cltess.orient import orient_scene
-
-        scene, orientation = orient_scene(scene)
     if args.pixels is not None and scene.camera is None and getattr(args, "camera_path", None) is None:
         raise UsageError(f"{args.scene}: --pixels needs a camera in the scene (use a .json scene "
                          "with a \"camera\", or give --eps)")
@@ -515,6 +512,13 @@ def _prepare_scene(args):
         if too_fine:
             print(f"{PROG}: warning: {args.scene}: {too_fine}", file=sys.stderr)
     tolerance = eps_text if args.eps is not None else f"{args.pixels:g} px"
+    if loaded is not None:
+        loaded(scene)
+    orientation = None
+    if args.orient:
+        from cltess.orient import orient_scene
+
+        scene, orientation = orient_scene(scene)
     return scene, orientation, tolerance
 
 
@@ -568,18 +572,30 @@ def cmd_tessellate(args) -> int:
     if args.uv == "seam" and output.suffix.lower() not in (".ply", ".obj", ".npz"):
         raise UsageError(f"{output}: --uv seam can be written to .ply, .obj or .npz only")
     preview = _check_preview(args.preview, args.scene) if args.preview else None
-    # The scene first, then the device, one after the other.  (Opening OpenCL on a thread while
-    # the scene loads was tried: Python's warning filters are one global list, and the text
-    # parser's catch_warnings(simplefilter("error")) turned pyopencl's compiler-output warning on
-    # the other thread into an exception, which pyopencl's cache reports as a KeyError.)
-    scene, orientation, eps_text = _prepare_scene(args)
-    device = pick_device(args.device)
-
     from cltess.pipeline import Tessellator  # lazy: builds OpenCL programs
 
-    tessellator = Tessellator(device=device)
-    mesh_options = {"sharp_edges": args.sharp_edges} if scene.meshes else {}
-    mesh_options.update(_level_options(args, scene))
+    # The scene is read and checked first; then OpenCL starts on a thread (platforms, device,
+    # context, and the programs the plan will want) while this one orients the scene.  Not while
+    # the scene is read: Python's warning filters are one global list, and the text parser's
+    # catch_warnings(simplefilter("error")) (io/text.py, where long double is not x87) turned
+    # pyopencl's compiler-output warning on the other thread into an exception (a KeyError from
+    # pyopencl's cache).  Orientation changes no warning filter.
+    opening, options = [], {}
+
+    def loaded(scene):
+        options.update({"sharp_edges": args.sharp_edges} if scene.meshes else {})
+        options.update(_level_options(args, scene))
+        options.update(eps=args.eps, pixels=args.pixels, max_factor=args.max_factor,
+                       pattern=PATTERN_CHOICES[args.pattern], max_level=args.max_level, emit=EMIT_CHOICES[args.emit])
+        opening.append(_in_background(lambda: _opened(Tessellator(device=pick_device(args.device)), scene, options)))
+
+    try:
+        scene, orientation, eps_text = _prepare_scene(args, loaded)
+    except BaseException:
+        for thread in opening:
+            thread.join()  # nothing left running; the scene's error is the one reported
+        raise
+    tessellator = opening[0].result()
     def before_writing(plan):
         """After stages 1-3, before anything big exists: warn, estimate, refuse."""
         _warn_saturated(int(plan.stats.get("saturated", 0)), args)
@@ -610,9 +626,7 @@ def cmd_tessellate(args) -> int:
             on_plan=before_writing, progress=progress,
             on_batch=(lambda batch: drawing.add(batch.positions, batch.triangles, normals=batch.normals))
             if drawing else None,
-            eps=args.eps, pixels=args.pixels, max_factor=args.max_factor, forward_differencing=not args.no_fd,
-            pattern=PATTERN_CHOICES[args.pattern], max_level=args.max_level, emit=EMIT_CHOICES[args.emit],
-            verify=args.verify, **mesh_options)
+            forward_differencing=not args.no_fd, verify=args.verify, **options)
     if drawing is not None:
         from cltess.render import write_png
 
@@ -639,9 +653,47 @@ def cmd_tessellate(args) -> int:
               "curve, so the mesh may crack there; --sharp-edges straight or average keeps it closed",
               file=sys.stderr)
     if not args.quiet:
-        print(format_summary(result.stats, result.stage_ms, scene=args.scene, device=device.name.strip(),
+        print(format_summary(result.stats, result.stage_ms, scene=args.scene, device=tessellator.device.name.strip(),
                              tolerance=eps_text, output=output if preview is None else f"{output}, {preview}"))
     return EXIT_OK
+
+
+def _opened(tessellator, scene, options: dict):
+    """The tessellator, with the programs ``plan(scene, **options)`` will want already built: a
+    warm-up on the OpenCL thread (``Tessellator.compose``, about 0.09 s for the 30k-patch
+    scene); whatever fails here fails again in the plan, which reports it."""
+    from cltess.request import Request
+
+    try:
+        tessellator.compose(scene, Request.of(**options))
+    except Exception:  # noqa: BLE001 (the plan composes again and reports it)
+        pass
+    return tessellator
+
+
+class _in_background:
+    """``make()`` on a thread started now; ``result()`` joins it and returns its value or
+    raises its exception (``join()``: waits only)."""
+
+    def __init__(self, make):
+        self._value, self._error = None, None
+        self._thread = threading.Thread(target=self._run, args=(make,), name="cltess-opencl", daemon=True)
+        self._thread.start()
+
+    def _run(self, make):
+        try:
+            self._value = make()
+        except BaseException as error:  # handed to result()
+            self._error = error
+
+    def join(self) -> None:
+        self._thread.join()
+
+    def result(self):
+        self._thread.join()
+        if self._error is not None:
+            raise self._error
+        return self._value
 
 
 def cmd_tessellate_frames(args) -> int:

@@ -368,6 +368,59 @@ def test_a_scene_error_is_reported_before_a_device_error(capsys, tmp_path, fake_
     assert list(tmp_path.iterdir()) == []
 
 
+def test_a_scene_check_error_is_reported_before_a_device_error_and_no_thread_is_left(capsys, tmp_path, scene_file,
+                                                                                     fake_pipeline):
+    """OpenCL opens on a thread once the scene is read: a scene that reads but fails a later
+    check (--pixels without a camera) is the error reported (exit 2), not the device's, and the
+    thread has ended."""
+    import threading
+
+    code, _, err = run(capsys, "tessellate", scene_file, "--pixels", "0.5", "--device", "no-such-gpu",
+                       "-o", tmp_path / "out.ply")
+    assert code == 2
+    assert_clean_error(err, "camera")
+    assert "no-such-gpu" not in err
+    assert not [t for t in threading.enumerate() if t.name == "cltess-opencl"]
+
+
+def test_opencl_starts_after_the_scene_is_read(capsys, tmp_path, scene_file, fake_pipeline, monkeypatch):
+    """The OpenCL thread starts only once the scene is read (the text parser's warning filters
+    are global: io/text.py), and its tessellator is the one used."""
+    import cltess.io
+
+    events = []
+    read = cltess.io.load_scene
+    monkeypatch.setattr(cltess.io, "load_scene", lambda *a, **k: (read(*a, **k), events.append("read"))[0])
+    opened = FakeTessellator.__init__
+    monkeypatch.setattr(FakeTessellator, "__init__", lambda self, device=None: (
+        events.append("opened"), opened(self, device))[1])
+    monkeypatch.setattr(FakeTessellator, "compose", lambda self, scene, request: events.append(request), raising=False)
+    code, _, err = run(capsys, "tessellate", scene_file, "--eps", "1e-3", "-o", tmp_path / "out.ply")
+    assert code == 0, err
+    assert events[:2] == ["read", "opened"] and len(events) == 3
+    call = fake_pipeline.calls[0]
+    assert call["device"] is not None
+    # the programs built on the thread are those of the plan's request
+    assert events[2].tolerance.eps == call["eps"] == 1e-3 and events[2].pattern == call["pattern"]
+
+
+def test_a_failing_program_warm_up_leaves_the_error_to_the_plan(capsys, tmp_path, scene_file, fake_pipeline,
+                                                                 monkeypatch):
+    """cli._opened builds the plan's programs on the OpenCL thread; what fails there is met
+    again, and reported, by the plan."""
+    def compose(self, scene, request):
+        raise RuntimeError("build failed")
+
+    monkeypatch.setattr(FakeTessellator, "compose", compose, raising=False)
+    code, _, err = run(capsys, "tessellate", scene_file, "--eps", "1e-3", "-o", tmp_path / "out.ply")
+    assert code == 0, err
+    assert len(fake_pipeline.calls) == 1
+    fake_pipeline.result = RuntimeError("build failed")
+    code, _, err = run(capsys, "tessellate", scene_file, "--eps", "1e-3", "-o", tmp_path / "out2.ply")
+    assert code == 1
+    assert_clean_error(err, "build failed")
+
+
 def test_interrupt_during_export_leaves_no_file(capsys, tmp_path, scene_file, fake_pipeline, monkeypatch):
     def interrupted(fd):
         raise KeyboardInterrupt

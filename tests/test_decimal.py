@@ -148,3 +148,53 @@ def test_bez_files_read_the_same_piece_by_piece(tmp_path, monkeypatch, rng):
     whole = bez._fast_bez(path.read_bytes())
     monkeypatch.setattr(text, "PIECE_BYTES", 100)
     assert whole is not None and bez._fast_bez(path.read_bytes()).tobytes() == whole.tobytes()
+
+
+@pytest.mark.parametrize("commas", [False, True])
+def test_pieces_on_threads_finishing_in_any_order_give_the_serial_numbers(monkeypatch, rng, commas):
+    """The pieces parse on threads (text.PARSE_THREADS): pieces made to finish out of order
+    (random delays) give bitwise what one thread gives, and a bad token in any piece makes the
+    whole text None (the line-by-line reader then names its line)."""
+    import threading
+    import time
+
+    separator = "," if commas else " "
+    lines = [separator.join(repr(v) for v in rng.normal(size=rng.integers(1, 6)).tolist()) for _ in range(400)]
+    data = ("\n".join(lines) + "\n").encode()
+    monkeypatch.setattr(text, "PIECE_BYTES", 200)
+    monkeypatch.setattr(text, "PARSE_THREADS", 1)
+    serial = numbers_fields(text._Numbers.of(data, commas))
+    threads, piece = set(), text._piece
+
+    def late(*args):
+        threads.add(threading.get_ident())
+        time.sleep(float(rng.uniform(0, 0.003)))
+        return piece(*args)
+
+    monkeypatch.setattr(text, "_piece", late)
+    monkeypatch.setattr(text, "PARSE_THREADS", 4)
+    monkeypatch.setattr(text.os, "cpu_count", lambda: 4)
+    assert numbers_fields(text._Numbers.of(data, commas)) == serial
+    assert len(threads) > 1
+    for line in (0, 150, 399):
+        bad = lines.copy()
+        bad[line] = bad[line].replace(".", "..", 1)
+        assert text._Numbers.of(("\n".join(bad) + "\n").encode(), commas) is None
+
+
+def test_a_bad_token_in_any_piece_on_threads_is_reported_at_its_line(tmp_path, monkeypatch, rng):
+    """The same file, a bad token on each of a few lines in turn: the error names its line
+    whichever thread's piece holds it."""
+    monkeypatch.setattr(text, "PIECE_BYTES", 128)
+    monkeypatch.setattr(text.os, "cpu_count", lambda: 4)
+    path = tmp_path / "p.bpt"
+    patches = rng.normal(size=(12, 4, 4, 4))
+    patches[..., 3] = 1.0
+    bpt.write(path, patches)
+    lines = path.read_text().splitlines()
+    for line in (3, 100, 150, len(lines) - 1):
+        bad = lines.copy()
+        bad[line] = bad[line].replace(".", "e.", 1)
+        path.write_text("\n".join(bad) + "\n")
+        with pytest.raises(SceneError, match=f"p.bpt: line {line + 1}: "):
+            bpt.read(path)

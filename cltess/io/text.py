@@ -4,8 +4,10 @@ Every problem is a :class:`~cltess.scene.SceneError` naming the file and the 1-b
 from __future__ import annotations
 
 import math
+import os
 import re
 import warnings
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -165,6 +167,8 @@ _COMMA_TO_SPACE = bytes.maketrans(b",", b" ")
 #: piece stay in memory the process already has (fresh pages cost more than the work here:
 #: bench/RESULTS.md, "Issue 15: the 30k-patch PLY cold and warm (session 8)").
 PIECE_BYTES = 1 << 20
+#: Most threads the pieces are parsed on (one per core up to this).
+PARSE_THREADS = 4
 
 
 class _Numbers:
@@ -199,24 +203,22 @@ class _Numbers:
         most = len(data) // 2 + 1
         values, start, lengths = np.empty(most), np.empty(most, np.int64), np.empty(most, np.int64)
         per_line, commas_per_line = [], []
-        count = offset = 0
-        while offset < len(data):  # pieces of whole lines
-            cut = data.find(b"\n", offset + PIECE_BYTES) + 1 or len(data)
-            piece = data[offset:cut]
-            begin, end, newlines, comma = _tokens(piece, commas)
-            numbers = decimal.parse_decimals(piece, begin, end)
-            if numbers is None:
-                return None
-            values[count:count + len(numbers)] = numbers
-            start[count:count + len(numbers)] = begin + offset
-            lengths[count:count + len(numbers)] = end - begin
-            count += len(numbers)
-            # the tokens on each physical line of the piece: the newlines before a token (a binary
-            # search among them) are its line; a piece's last slot is a line the next one goes on
-            per_line.append(np.bincount(np.searchsorted(newlines, begin), minlength=len(newlines) + 1))
-            if commas:
-                commas_per_line.append(np.bincount(np.searchsorted(newlines, comma), minlength=len(newlines) + 1))
-            offset = cut
+        count = 0
+        # The pieces on threads, one per core, their results copied out in file order: NumPy
+        # releases the GIL in nearly all of a piece's work (the 30k-patch scene on two cores:
+        # 0.255 s median against 0.301 on one, bench/RESULTS.md "Issue 15: the cold 30k-patch
+        # PLY (session 10, branch `ply15d`)").
+        with ThreadPoolExecutor(min(PARSE_THREADS, os.cpu_count() or 1)) as pool:
+            for part in pool.map(lambda bounds: _piece(data, *bounds, commas), _pieces(data)):
+                if part is None:
+                    return None
+                numbers, begin, end, lines, comma_lines = part
+                values[count:count + len(numbers)] = numbers
+                start[count:count + len(numbers)] = begin
+                lengths[count:count + len(numbers)] = end - begin
+                count += len(numbers)
+                per_line.append(lines)
+                commas_per_line.append(comma_lines)
         values, start, lengths, per_line = values[:count], start[:count], lengths[:count], np.concatenate(per_line)
         if not count or not np.isfinite(values).all():
             return None
@@ -274,6 +276,30 @@ class _Numbers:
         end_token = self.first[last_line - 1] + self.per_line[last_line - 1] - 1
         end = int(self.start[end_token] + self.lengths[end_token])
         return bool(table[self.data[begin:end]].all())
+
+
+def _pieces(data: bytes):
+    """(offset, end) of each piece of whole lines of about PIECE_BYTES."""
+    offset = 0
+    while offset < len(data):
+        cut = data.find(b"\n", offset + PIECE_BYTES) + 1 or len(data)
+        yield offset, cut
+        offset = cut
+
+
+def _piece(data: bytes, offset: int, cut: int, commas: bool):
+    """The tokens of ``data[offset:cut]`` (whole lines): (values, start, end) in ``data``'s
+    offsets, and the tokens (commas) on each physical line, the last slot a line the next piece
+    goes on; None if a token is not one number (``decimal.parse_decimals``)."""
+    piece = data[offset:cut]
+    begin, end, newlines, comma = _tokens(piece, commas)
+    numbers = decimal.parse_decimals(piece, begin, end)
+    if numbers is None:
+        return None
+    # a token's line: the newlines before it (a binary search among them)
+    lines = np.bincount(np.searchsorted(newlines, begin), minlength=len(newlines) + 1)
+    comma_lines = np.bincount(np.searchsorted(newlines, comma), minlength=len(newlines) + 1) if commas else None
+    return numbers, begin + offset, end + offset, lines, comma_lines
 
 
 def _tokens(text: bytes, commas: bool):
