@@ -90,8 +90,8 @@ def timed(launch, repeat: int) -> dict:
             "cpu_ms": min(cpu), "cpu_ms_median": statistics.median(cpu)}
 
 
-def build(context, device, folder: Path, stage_source: str, stage: str, pattern, defines=()) -> cl.Program:
-    headers, _ = composition(stage, kind=BEZIER, pattern=pattern)
+def build(context, device, folder: Path, stage_source: str, stage: str, pattern, defines=(), kind=BEZIER) -> cl.Program:
+    headers, _ = composition(stage, kind=kind, pattern=pattern)
     source = "".join(f'#include "{header}"\n' for header in ("common.h", *headers))
     source += "".join(f"#define {d}\n" for d in defines) + stage_source
     options = ["-I", str(folder)] + correctly_rounded_division(device)

@@ -10,7 +10,8 @@ builtins it calls out of line show by symbol.
 or a mesh/patch file (``--eps`` relative to its bounding box's diagonal, default 1e-3; ``.stl``/``.obj`` become PN
 triangles).  Tessellates ``--warm`` times untimed, then ``--launches`` times between the marks
 ``perf_scene: start``/``end`` (``time.monotonic()``, perf's clock with ``-k CLOCK_MONOTONIC``);
-prints the process CPU ms per tessellation (min, median) and a hash of the output.
+prints the process CPU ms per tessellation (min, median), a hash of the output and the
+median device ms of each stage (``Tessellation.stage_ms``).
 """
 from __future__ import annotations
 
@@ -51,12 +52,13 @@ def main(argv=None) -> int:
         options = {"eps": args.eps * float(scene.diagonal)}
     for _ in range(args.warm):
         tess = tessellator.tessellate(scene, **options)
-    cpu = []
+    cpu, stages = [], []
     print(f"perf_scene: start {time.monotonic():.3f}", file=sys.stderr, flush=True)
     for _ in range(args.launches):
         started = cpu_stages.cpu_seconds()
         tess = tessellator.tessellate(scene, **options)
         cpu.append((cpu_stages.cpu_seconds() - started) * 1e3)
+        stages.append(tess.stage_ms)
     print(f"perf_scene: end {time.monotonic():.3f}", file=sys.stderr, flush=True)
     hashed = hashlib.blake2b(digest_size=8)
     for field in ("positions", "normals", "uv", "triangles"):
@@ -64,6 +66,8 @@ def main(argv=None) -> int:
     print(f"{args.scene}: {scene.num_patches:,} patches, {len(tess.positions):,} vertices, "
           f"{len(tess.triangles):,} triangles, {args.launches} tessellations: CPU ms min {min(cpu):.0f}, "
           f"median {statistics.median(cpu):.0f}; bits {hashed.hexdigest()}")
+    print("  device ms, median: " + ", ".join(f"{k} {statistics.median(t[k] for t in stages):.1f}"
+                                              for k in stages[0] if k != "total_wall"))
     return 0
 
 
