@@ -16,6 +16,8 @@ inline int2 quad_core(int4 f, int *uniform)
     *uniform = f.s0 == f.s2 && f.s1 == f.s3;
     if (*uniform)
         return (int2)(f.s0, f.s1);
+    /* imin, imax: int min, max, inline on PoCL (common.h; bench/RESULTS.md, "Issue 15: PoCL's other
+     * out-of-line calls (session 10, branch `cpu15g`)") */
     return (int2)(imax(imin(f.s0, f.s2), 2), imax(imin(f.s1, f.s3), 2));
 }
 

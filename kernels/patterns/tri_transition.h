@@ -9,6 +9,8 @@
 
 #define PATTERN_EDGES 3
 
+/* imin, imax: int min, max, inline on PoCL (common.h; bench/RESULTS.md, "Issue 15: PoCL's other
+ * out-of-line calls (session 10, branch `cpu15g`)") */
 inline int tri_core(int4 f) { return imax(imax(f.s0, f.s1), f.s2); }
 
 /* --- the vertex layout ------------------------------------------------------------------------ */
