@@ -6,9 +6,8 @@ instruction.
         python bench/perf_stages.py --device pocl --stage 4 --launches 12 [--local 64] [--kernels DIR] [--define NAME ...]
     perf report -i stage4.data --time START,END --no-children --sort dso,sym --stdio -g none
 
-Uniform level 16 as ``bench/cpu_stages.py`` (or ``--scene``: a suite scene at ``--pixels``, e.g. the
-PN triangles of model_zoo) (``--copies`` teapots of 32 patches, every edge factor
-16), stages 1-3 planned once by the engine; then the named stage's per-patch kernel, built like
+Uniform level 16 as ``bench/cpu_stages.py`` (``--copies`` teapots of 32 patches, every edge factor
+16; or ``--scene``: a suite scene of one kind at ``--pixels``, e.g. the PN triangles of model_zoo), stages 1-3 planned once by the engine; then the named stage's per-patch kernel, built like
 cpu_stages.py does (from ``--kernels``, default this tree's kernels/, with ``-D`` ``--define``s),
 is launched ``--launches`` times, each waited, after ``--warm`` launches that are not timed
 (``--local``: with that work-group size; by default none, so the runtime picks: PoCL took 4,000
@@ -62,9 +61,10 @@ def main(argv=None) -> int:
         plan = tessellator.plan(frame_loop.suite_scene(args.scene), pixels=args.pixels)
     else:
         plan = tessellator.plan(frame_loop.teapots(args.copies), **frame_loop.uniform_request(16))
+    if len(plan.parts) != 1:
+        parser.error(f"{len(plan.parts)} kinds in the scene; this script runs a scene of one")
     part = plan.parts[0]
     patches, vertices = plan.num_patches, plan.num_vertices
-    assert len(plan.parts) == 1, "one kind only" 
     folder = Path(args.kernels) if args.kernels else kernel_dir()
     name = "vertices" if args.stage == 4 else "indices"
     kernel = getattr(cpu_stages.build(context, device, folder, (folder / "stages" / f"{name}.cl").read_text(),
