@@ -183,7 +183,19 @@ inline float3 unit_or(float3 n, float3 otherwise)
     float len = normal_length(n);
     if (!(len > 0.0f))
         return otherwise;
+#if CLTESS_POCL_FORMS
+    /* On PoCL x86-64 the three quotients as one vector division (PoCL made x a vdivss and y, z a
+     * vdivps): each lane the same correctly rounded quotient, a zero dividend (either sign) its own
+     * quotient as in quotient_by_positive, so the same bits; stage 4 -4.7%.  By the vector ?:, not
+     * select(), which PoCL keeps out of line (with select() stage 4 was 11% slower: bench/RESULTS.md,
+     * "Issue 15: PoCL's other out-of-line calls (session 10, branch `cpu15g`)"). */
+    float4 d = (float4)(n, 1.0f);
+    int4 zero = (as_int4(d) << 1) == 0;
+    float4 q = (zero ? (float4)(1.0f) : d) / len;
+    return (zero ? d : q).xyz;
+#else
     return (float3)(quotient_by_positive(n.x, len), quotient_by_positive(n.y, len), quotient_by_positive(n.z, len));
+#endif
 }
 
 /* Power-form coefficients of the cubic Bernstein polynomial with controls c. */
