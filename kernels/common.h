@@ -104,6 +104,9 @@ ALWAYS_INLINE void store2(float2 v, ulong at, __global float *out)
 ALWAYS_INLINE float sqrt1f(float a) { return __builtin_sqrtf(a); }
 ALWAYS_INLINE int imin(int a, int b) { return a > b ? b : a; }
 ALWAYS_INLINE int imax(int a, int b) { return a < b ? b : a; }
+/* a helper PoCL keeps out of line and that gains inline there (patterns/stitch.h stitch_strip);
+ * elsewhere plain inline, as before */
+#define POCL_INLINE ALWAYS_INLINE
 #else
 #define CLTESS_POCL_FORMS 0
 #define dot3f dot
@@ -114,6 +117,7 @@ ALWAYS_INLINE int imax(int a, int b) { return a < b ? b : a; }
 #define sqrt1f sqrt
 #define imin min
 #define imax max
+#define POCL_INLINE inline
 #endif
 
 /* a / |a| where |a| > 0, else 0 (PN triangles' normals; silhouette vertices).  The root as sqrt
