@@ -90,8 +90,8 @@ def timed(launch, repeat: int) -> dict:
             "cpu_ms": min(cpu), "cpu_ms_median": statistics.median(cpu)}
 
 
-def build(context, device, folder: Path, stage_source: str, stage: str, pattern, defines=()) -> cl.Program:
-    headers, _ = composition(stage, kind=BEZIER, pattern=pattern)
+def build(context, device, folder: Path, stage_source: str, stage: str, pattern, defines=(), kind=BEZIER) -> cl.Program:
+    headers, _ = composition(stage, kind=kind, pattern=pattern)
     source = "".join(f'#include "{header}"\n' for header in ("common.h", *headers))
     source += "".join(f"#define {d}\n" for d in defines) + stage_source
     options = ["-I", str(folder)] + correctly_rounded_division(device)
@@ -110,6 +110,7 @@ def main(argv=None) -> int:
     parser.add_argument("--device", help="OpenCL device (substring; default as cltess picks)")
     parser.add_argument("--copies", type=int, default=1000, help="teapots (32 patches each)")
     parser.add_argument("--scene", help="a suite scene (cltess.bench.suite) at 0.5 px instead of uniform level 16")
+    parser.add_argument("--pixels", type=float, help="--scene's pixel tolerance (default frame_loop.PIXELS, 0.5)")
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--baseline-kernels", help="a kernels/ folder to build stages 4-5 from too")
     parser.add_argument("--work", nargs="*", default=[],
@@ -129,7 +130,7 @@ def main(argv=None) -> int:
               "date": time.strftime("%Y-%m-%d %H:%M:%S %z"), "load_before": [round(x, 1) for x in os.getloadavg()]}
     if args.scene:  # a scene of the paper's suite at its camera, 0.5 px (as bench/frame_loop.py)
         scene = frame_loop.suite_scene(args.scene)
-        plan = tessellator.plan(scene, pixels=frame_loop.PIXELS)
+        plan = tessellator.plan(scene, pixels=args.pixels or frame_loop.PIXELS)
         if len(plan.parts) != 1:
             parser.error(f"--scene {args.scene}: {len(plan.parts)} kinds; this script runs a scene of one")
         record["scene"] = args.scene
@@ -161,8 +162,8 @@ def main(argv=None) -> int:
     kernels = {}
     for label, folder in folders:
         kernels[label] = (
-            build(context, device, folder, (folder / "stages" / "vertices.cl").read_text(), "vertices", part.pattern).vertices,
-            build(context, device, folder, (folder / "stages" / "indices.cl").read_text(), "indices", part.pattern).indices)
+            build(context, device, folder, (folder / "stages" / "vertices.cl").read_text(), "vertices", part.pattern, kind=part.kind).vertices,
+            build(context, device, folder, (folder / "stages" / "indices.cl").read_text(), "indices", part.pattern, kind=part.kind).indices)
     engines = {"": tessellator}
     if args.baseline_kernels and args.work:  # a Tessellator whose programs are built from the baseline's kernels/
         engines["baseline "] = Tessellator(args.device, work="patch")

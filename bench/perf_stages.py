@@ -7,7 +7,7 @@ instruction.
     perf report -i stage4.data --time START,END --no-children --sort dso,sym --stdio -g none
 
 Uniform level 16 as ``bench/cpu_stages.py`` (``--copies`` teapots of 32 patches, every edge factor
-16), stages 1-3 planned once by the engine; then the named stage's per-patch kernel, built like
+16; or ``--scene``: a suite scene of one kind at ``--pixels``, e.g. the PN triangles of model_zoo), stages 1-3 planned once by the engine; then the named stage's per-patch kernel, built like
 cpu_stages.py does (from ``--kernels``, default this tree's kernels/, with ``-D`` ``--define``s),
 is launched ``--launches`` times, each waited, after ``--warm`` launches that are not timed
 (``--local``: with that work-group size; by default none, so the runtime picks: PoCL took 4,000
@@ -51,17 +51,24 @@ def main(argv=None) -> int:
     parser.add_argument("--kernels", help="a kernels/ folder to build from (default this tree's)")
     parser.add_argument("--define", nargs="*", default=[], help="-D names for the build")
     parser.add_argument("--local", type=int, help="work-group size (default: none, the runtime's choice)")
+    parser.add_argument("--scene", help="a suite scene at --pixels (its first kind's patches) instead of the teapots")
+    parser.add_argument("--pixels", type=float, default=0.01)
     args = parser.parse_args(argv)
 
     tessellator = Tessellator(args.device, work="patch")
     context, queue, device = tessellator.context, tessellator.queue, tessellator.device
-    plan = tessellator.plan(frame_loop.teapots(args.copies), **frame_loop.uniform_request(16))
+    if args.scene:
+        plan = tessellator.plan(frame_loop.suite_scene(args.scene), pixels=args.pixels)
+    else:
+        plan = tessellator.plan(frame_loop.teapots(args.copies), **frame_loop.uniform_request(16))
+    if len(plan.parts) != 1:
+        parser.error(f"{len(plan.parts)} kinds in the scene; this script runs a scene of one")
     part = plan.parts[0]
     patches, vertices = plan.num_patches, plan.num_vertices
     folder = Path(args.kernels) if args.kernels else kernel_dir()
     name = "vertices" if args.stage == 4 else "indices"
     kernel = getattr(cpu_stages.build(context, device, folder, (folder / "stages" / f"{name}.cl").read_text(),
-                                      name, part.pattern, args.define), name)
+                                      name, part.pattern, args.define, part.kind), name)
     per_patch = (-(-patches // 64) * 64,)
     if args.stage == 4:
         out = [cl_array.empty(queue, (vertices, *shape), dtype) for _, dtype, shape in VERTEX_RECORD]

@@ -47,12 +47,6 @@ inline float4 lerp4(float4 a, float4 b, float t) { return a + t * (b - a); }
 
 inline float dot3(float3 a, float3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 
-inline float3 unit_or_zero(float3 a)
-{
-    float len = sqrt(dot3(a, a));
-    return len > 0.0f ? a / len : (float3)(0.0f);
-}
-
 /* --- PoCL's builtins inline (issue 15, the CPU line) ---------------------------------------------
  * PoCL 3.0 on x86-64 (LLVM 14; it defines POCL_DEVICE_ADDRESS_BITS) keeps cross, dot, length,
  * vstore3 and vstore2 of float3/float2 out of line: in stage 4 (stages/vertices.cl) every vertex
@@ -103,6 +97,16 @@ ALWAYS_INLINE void store2(float2 v, ulong at, __global float *out)
     out[2 * at] = v.x;
     out[2 * at + 1] = v.y;
 }
+/* sqrt(float), int min and int max, also out of line on PoCL 3.0 (PN triangles' unit_or_zero in
+ * stage 4, the patterns' row and cell code in stage 5): PoCL's own bodies are vsqrtss, and
+ * `a > b ? b : a` / `a < b ? b : a` by cmovg / cmovl (bench/RESULTS.md, "Issue 15: PoCL's other
+ * out-of-line calls (session 10, branch `cpu15g`)"). */
+ALWAYS_INLINE float sqrt1f(float a) { return __builtin_sqrtf(a); }
+ALWAYS_INLINE int imin(int a, int b) { return a > b ? b : a; }
+ALWAYS_INLINE int imax(int a, int b) { return a < b ? b : a; }
+/* a helper PoCL keeps out of line and that gains inline there (patterns/stitch.h stitch_strip);
+ * elsewhere plain inline, as before */
+#define POCL_INLINE ALWAYS_INLINE
 #else
 #define CLTESS_POCL_FORMS 0
 #define dot3f dot
@@ -110,7 +114,19 @@ ALWAYS_INLINE void store2(float2 v, ulong at, __global float *out)
 #define length3 length
 #define store3 vstore3
 #define store2 vstore2
+#define sqrt1f sqrt
+#define imin min
+#define imax max
+#define POCL_INLINE inline
 #endif
+
+/* a / |a| where |a| > 0, else 0 (PN triangles' normals; silhouette vertices).  The root as sqrt
+ * (inline on PoCL: sqrt1f above). */
+inline float3 unit_or_zero(float3 a)
+{
+    float len = sqrt1f(dot3(a, a));
+    return len > 0.0f ? a / len : (float3)(0.0f);
+}
 
 /* --- division without a zero dividend (issue 15, NVIDIA) ---------------------------------------
  * NVIDIA's correctly rounded division (div.rn.f32: MUFU.RCP, a refinement and FCHK) calls a slow
@@ -171,7 +187,19 @@ inline float3 unit_or(float3 n, float3 otherwise)
     float len = normal_length(n);
     if (!(len > 0.0f))
         return otherwise;
+#if CLTESS_POCL_FORMS
+    /* On PoCL x86-64 the three quotients as one vector division (PoCL made x a vdivss and y, z a
+     * vdivps): each lane the same correctly rounded quotient, a zero dividend (either sign) its own
+     * quotient as in quotient_by_positive, so the same bits; stage 4 -4.7%.  By the vector ?:, not
+     * select(), which PoCL keeps out of line (with select() stage 4 was 11% slower: bench/RESULTS.md,
+     * "Issue 15: PoCL's other out-of-line calls (session 10, branch `cpu15g`)"). */
+    float4 d = (float4)(n, 1.0f);
+    int4 zero = (as_int4(d) << 1) == 0;
+    float4 q = (zero ? (float4)(1.0f) : d) / len;
+    return (zero ? d : q).xyz;
+#else
     return (float3)(quotient_by_positive(n.x, len), quotient_by_positive(n.y, len), quotient_by_positive(n.z, len));
+#endif
 }
 
 /* Power-form coefficients of the cubic Bernstein polynomial with controls c. */
@@ -247,7 +275,7 @@ inline float fractional_location(int fixed, int i)
  * i.e. the location is 1 - it); a midpoint (2k == f, whole factors only) is 0.5 exactly. */
 inline float edge_near_fraction(edge_param t, int *from_end)
 {
-    int near = min(t.k, t.f - t.k);
+    int near = imin(t.k, t.f - t.k);
     *from_end = near != t.k;
     return t.fixed ? fractional_location(t.fixed, near) : (float)near / (float)t.f;
 }
@@ -324,7 +352,7 @@ inline int factor_of(int4 f, int e) { return e == 0 ? f.s0 : e == 1 ? f.s1 : e =
 inline int edge_factor(float inverse, int max_factor, int *saturated)
 {
     if (inverse <= (float)max_factor)
-        return max((int)ceil(inverse), 1);
+        return imax((int)ceil(inverse), 1);
     *saturated = 1;
     return max_factor;
 }
@@ -341,7 +369,7 @@ inline int dyadic_factor(int f, int max_level, int *saturated)
     int level = f > 1 ? 32 - (int)clz(f - 1) : 0;
     if (level > max_level)
         *saturated = 1;
-    return 1 << min(level, max_level);
+    return 1 << imin(level, max_level);
 }
 
 inline int4 dyadic_factors(int4 f, int max_level, int *saturated)

@@ -89,26 +89,33 @@ __kernel void builtins(__global const float4 *a, __global const float4 *b, __glo
 """
 
 
-def test_spelled_builtins_are_the_builtins(tessellator):
-    """common.h's dot3f, cross3, length3, store3, store2 (PoCL's builtins spelled out, inline
-    there) give the builtins' bits on 20,000 pairs with signed zeros, infinities, NaNs, subnormals
-    and values whose squares overflow or underflow (length3's scaled branches)."""
+def run_pair_kernel(tessellator, source: str, name: str, a: np.ndarray, b: np.ndarray, outputs, seed: int) -> None:
+    """Build ``source`` after common.h, give a's last 2,000 rows magnitudes 2^-149 .. 2^127 (some
+    squares overflow or underflow), run kernel ``name`` on a, b, one work-item a row, and read
+    its outputs into the arrays ``outputs``."""
     ctx, queue = tessellator.context, tessellator.queue
-    device = ctx.devices[0]
-    options = ["-I", str(kernel_dir())] + correctly_rounded_division(device)
-    program = cl.Program(ctx, '#include "common.h"\n' + BUILTINS_KERNEL).build(options=options)
-    count = 20000
-    a, b = vectors(count, seed=16), vectors(count, seed=17)
-    rng = np.random.default_rng(18)
+    options = ["-I", str(kernel_dir())] + correctly_rounded_division(ctx.devices[0])
+    program = cl.Program(ctx, '#include "common.h"\n' + source).build(options=options)
+    rng = np.random.default_rng(seed)
     with np.errstate(over="ignore"):  # some overflow to +-inf: wanted too
         a[-2000:, :3] = (rng.standard_normal((2000, 3)) * 2.0 ** rng.integers(-149, 128, (2000, 3))).astype(np.float32)
     mf = cl.mem_flags
     sources = [cl.Buffer(ctx, mf.READ_ONLY | mf.COPY_HOST_PTR, hostbuf=v) for v in (a, b)]
-    spelled, builtin, forms = np.empty((count, 9), np.float32), np.empty((count, 9), np.float32), np.zeros(1, np.int32)
-    buffers = [cl.Buffer(ctx, mf.WRITE_ONLY, x.nbytes) for x in (spelled, builtin, forms)]
-    program.builtins(queue, (count,), None, *sources, *buffers)
-    for x, buffer in zip((spelled, builtin, forms), buffers):
+    buffers = [cl.Buffer(ctx, mf.WRITE_ONLY, x.nbytes) for x in outputs]
+    getattr(program, name)(queue, (len(a),), None, *sources, *buffers)
+    for x, buffer in zip(outputs, buffers):
         cl.enqueue_copy(queue, x, buffer)
+
+
+def test_spelled_builtins_are_the_builtins(tessellator):
+    """common.h's dot3f, cross3, length3, store3, store2 (PoCL's builtins spelled out, inline
+    there) give the builtins' bits on 20,000 pairs with signed zeros, infinities, NaNs, subnormals
+    and values whose squares overflow or underflow (length3's scaled branches)."""
+    count = 20000
+    a, b = vectors(count, seed=16), vectors(count, seed=17)
+    spelled, builtin, forms = np.empty((count, 9), np.float32), np.empty((count, 9), np.float32), np.zeros(1, np.int32)
+    run_pair_kernel(tessellator, BUILTINS_KERNEL, "builtins", a, b, (spelled, builtin, forms), seed=18)
+    device = tessellator.context.devices[0]
     differ = spelled.view(np.uint32) != builtin.view(np.uint32)
     first = np.nonzero(differ.any(axis=1))[0][:3]
     assert not differ.any(), (f"floats differing by column (cross x3, dot, length, 0, store2 x2, length): "
@@ -118,3 +125,45 @@ def test_spelled_builtins_are_the_builtins(tessellator):
     assert (lengths[np.isfinite(lengths)] > 0).any()
     if "Portable Computing Language" in device.platform.name and "x86_64" in device.version:
         assert forms[0] == 1  # PoCL on x86-64: the spelled-out forms are what ran
+
+
+FORMS_KERNEL = """
+__kernel void forms(__global const float4 *a, __global const float4 *b, __global float *spelled,
+                    __global float *builtin, __global int *ints)
+{
+    int id = get_global_id(0);
+    float3 x = a[id].xyz, y = b[id].xyz;
+    float3 u = unit_or_zero(x);
+    float len = sqrt(dot3(x, x));
+    float3 v = len > 0.0f ? x / len : (float3)(0.0f);
+    spelled[4 * id] = sqrt1f(x.x);
+    spelled[4 * id + 1] = u.x;
+    spelled[4 * id + 2] = u.y;
+    spelled[4 * id + 3] = u.z;
+    builtin[4 * id] = sqrt(x.x);
+    builtin[4 * id + 1] = v.x;
+    builtin[4 * id + 2] = v.y;
+    builtin[4 * id + 3] = v.z;
+    int i = as_int(a[id].w) >> (id % 31), j = as_int(b[id].w) >> (id % 29);
+    ints[4 * id] = imin(i, j);
+    ints[4 * id + 1] = min(i, j);
+    ints[4 * id + 2] = imax(i, j);
+    ints[4 * id + 3] = max(i, j);
+}
+"""
+
+
+def test_spelled_sqrt_min_max_are_the_builtins(tessellator):
+    """common.h's sqrt1f, imin, imax (PoCL's sqrt(float), min(int), max(int) spelled out, inline
+    there: issue 15, branch cpu15g) and unit_or_zero (its root by sqrt1f) give the builtins' bits
+    on 20,000 pairs with signed zeros, infinities, NaNs, subnormals and negative roots."""
+    count = 20000
+    a, b = vectors(count, seed=26), vectors(count, seed=27)
+    a[:100, 3] = np.array([0, -1, 1, 2**31 - 1, -2**31], np.int32).view(np.float32)[np.arange(100) % 5]
+    spelled, builtin, ints = np.empty((count, 4), np.float32), np.empty((count, 4), np.float32), np.empty((count, 4), np.int32)
+    run_pair_kernel(tessellator, FORMS_KERNEL, "forms", a, b, (spelled, builtin, ints), seed=28)
+    differ = spelled.view(np.uint32) != builtin.view(np.uint32)
+    assert not differ.any(), f"floats differing by column (sqrt, unit_or_zero x3): {differ.sum(axis=0)}"
+    assert np.isnan(builtin[:, 0]).any() and (builtin[:, 0] > 0).any()  # negative and positive roots met
+    assert (ints[:, 0] == ints[:, 1]).all() and (ints[:, 2] == ints[:, 3]).all()
+    assert (ints[:, 0] != ints[:, 2]).any()

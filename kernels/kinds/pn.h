@@ -109,7 +109,9 @@ inline float3 pn_unit_normal(const float4 b[16], float3 n)
 {
     if (dot3(n, n) > PN_NORMAL_VANISHES * PN_NORMAL_VANISHES)
         return unit_or_zero(n);
-    float3 face = unit_or_zero(cross(b[1].xyz - b[0].xyz, b[2].xyz - b[0].xyz));
+    /* cross3 and unit_or_zero's root: inline on PoCL (common.h; bench/RESULTS.md, "Issue 15: PoCL's
+     * other out-of-line calls (session 10, branch `cpu15g`)") */
+    float3 face = unit_or_zero(cross3(b[1].xyz - b[0].xyz, b[2].xyz - b[0].xyz));
     return dot3(face, face) > 0.0f ? face : (float3)(0.0f, 0.0f, 1.0f);
 }
 

@@ -16,7 +16,9 @@ inline int2 quad_core(int4 f, int *uniform)
     *uniform = f.s0 == f.s2 && f.s1 == f.s3;
     if (*uniform)
         return (int2)(f.s0, f.s1);
-    return (int2)(max(min(f.s0, f.s2), 2), max(min(f.s1, f.s3), 2));
+    /* imin, imax: int min, max, inline on PoCL (common.h; bench/RESULTS.md, "Issue 15: PoCL's other
+     * out-of-line calls (session 10, branch `cpu15g`)") */
+    return (int2)(imax(imin(f.s0, f.s2), 2), imax(imin(f.s1, f.s3), 2));
 }
 
 /* --- the vertex layout ------------------------------------------------------------------------ */
@@ -136,8 +138,8 @@ ALWAYS_INLINE void grid_cells(__global uint *out, uint *count, uint base, patter
     uint ring = (uint)(g.f.s0 + g.f.s1 + g.f.s2 + g.f.s3), inner = (uint)(g.core.x - 1);
     for (int j = j0; j < j1; ++j) {
         int inner_row = j > 0 && j + 1 < g.core.y;
-        int lo = inner_row ? min(max(i0, 1), i1) : i1;  /* cells i0 .. lo - 1: on the ring (i = 0) */
-        int hi = inner_row ? max(lo, min(i1, g.core.x - 1)) : i1;  /* lo .. hi - 1 inner */
+        int lo = inner_row ? imin(imax(i0, 1), i1) : i1;  /* cells i0 .. lo - 1: on the ring (i = 0) */
+        int hi = inner_row ? imax(lo, imin(i1, g.core.x - 1)) : i1;  /* lo .. hi - 1 inner */
         for (int i = i0; i < lo; ++i)
             grid_cell(out, count, base, g, collapsed, i, j);
         if (out) {
@@ -189,7 +191,7 @@ inline int pattern_triangles_of(int4 f, int collapsed, __private pattern_triangl
     g->c3 = (collapsed >> 3) & 1;
     g->middle = 2 * (uint)a_steps - g->c1 - g->c3;  /* a row that touches neither edge 0 nor edge 2 */
     g->first = (g->c0 ? 0 : (uint)a_steps - g->c1) + (b_steps == 1 && g->c2 ? 0 : (uint)a_steps - g->c3);
-    g->inner = (uint)max(b_steps - 2, 0) * g->middle;
+    g->inner = (uint)imax(b_steps - 2, 0) * g->middle;
     g->middle_rcp = g->middle ? 1.0f / (float)g->middle : 0.0f;
     return grid.uniform;
 }

@@ -21,8 +21,11 @@ typedef struct {
 /* Outer segment o's midpoint (o + 1/2) / f_e comes first when (2o + 1) along <= (2k + lead) f_e,
  * in integers.  Triangles counter-clockwise, as the ring runs.  collapsed: the edge's points
  * coincide (patch_factors), so the triangles on its segments are left out. */
-inline void stitch_strip(__global uint *out, uint *count, uint base, pattern_grid g, int e, stitch_row row,
-                         int collapsed)
+/* POCL_INLINE: always inline on PoCL, which kept it out of line (28% of PN stage 5's samples in it;
+ * inline, stage 5 -4.9% on PN triangles, -1.7% on the teapots: bench/RESULTS.md, "Issue 15: PoCL's
+ * other out-of-line calls (session 10, branch `cpu15g`)"); plain inline elsewhere. */
+POCL_INLINE void stitch_strip(__global uint *out, uint *count, uint base, pattern_grid g, int e, stitch_row row,
+                              int collapsed)
 {
     int4 f = g.f;
     int outer_n = factor_of(f, e), o = 0, k = row.first;

@@ -9,7 +9,9 @@
 
 #define PATTERN_EDGES 3
 
-inline int tri_core(int4 f) { return max(max(f.s0, f.s1), f.s2); }
+/* imin, imax: int min, max, inline on PoCL (common.h; bench/RESULTS.md, "Issue 15: PoCL's other
+ * out-of-line calls (session 10, branch `cpu15g`)") */
+inline int tri_core(int4 f) { return imax(imax(f.s0, f.s1), f.s2); }
 
 /* --- the vertex layout ------------------------------------------------------------------------ */
 
@@ -22,7 +24,7 @@ inline edge_param pattern_ring_param(int4 f, int e, int k)
 
 inline float3 pattern_edge_point(int e, edge_param t) { return tri_edge_point(e, t); }
 
-inline int pattern_rows(int4 f) { return max(tri_core(f) - 2, 0); }
+inline int pattern_rows(int4 f) { return imax(tri_core(f) - 2, 0); }
 
 /* Row j (v = j / N) runs from (0, v, 1-v) to (1-v, v, 0) in N - j steps. */
 inline int pattern_row(int4 f, int j) { return tri_core(f) - j; }
