@@ -45,7 +45,7 @@ inline void bernstein2(float t, float b[3])
 
 inline float4 lerp4(float4 a, float4 b, float t) { return a + t * (b - a); }
 
-inline float dot3(float3 a, float3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+ALWAYS_INLINE float dot3(float3 a, float3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 
 /* --- PoCL's builtins inline (issue 15, the CPU line) ---------------------------------------------
  * PoCL 3.0 on x86-64 (LLVM 14; it defines POCL_DEVICE_ADDRESS_BITS) keeps cross, dot, length,
@@ -61,8 +61,8 @@ inline float dot3(float3 a, float3 b) { return a.x * b.x + a.y * b.y + a.z * b.z
  * path uses them (kinds/bezier.h tangent_cross, unit_or's length, put_vertex's stores). */
 #if defined(POCL_DEVICE_ADDRESS_BITS) && defined(__x86_64__) && !defined(CLTESS_BUILTIN_FORMS)
 #define CLTESS_POCL_FORMS 1
-/* (a.x b.x + a.y b.y) + a.z b.z, PoCL's dot(float3) */
-ALWAYS_INLINE float dot3f(float3 a, float3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+/* PoCL's dot(float3) is (a.x b.x + a.y b.y) + a.z b.z: dot3 above */
+#define dot3f dot3
 /* PoCL's cross(float3), component by component */
 ALWAYS_INLINE float3 cross3(float3 a, float3 b)
 {
@@ -104,8 +104,8 @@ ALWAYS_INLINE void store2(float2 v, ulong at, __global float *out)
 ALWAYS_INLINE float sqrt1f(float a) { return __builtin_sqrtf(a); }
 ALWAYS_INLINE int imin(int a, int b) { return a > b ? b : a; }
 ALWAYS_INLINE int imax(int a, int b) { return a < b ? b : a; }
-/* a helper PoCL keeps out of line and that gains inline there (patterns/stitch.h stitch_strip);
- * elsewhere plain inline, as before */
+/* a helper PoCL keeps out of line and that gains inline there (patterns/stitch.h stitch_strip,
+ * patterns/quad_transition.h grid_cell and grid_cells); elsewhere plain inline, as before */
 #define POCL_INLINE ALWAYS_INLINE
 #else
 #define CLTESS_POCL_FORMS 0

@@ -115,7 +115,7 @@ inline uint grid_point_index(pattern_grid g, int2 point)
 /* Cell (i, j) of the grid, two triangles (a, b, c), (a, c, d) with a = (i, j), b = (i + 1, j),
  * c = (i + 1, j + 1), d = (i, j + 1); a triangle with a side on a collapsed edge (bit e of
  * collapsed) joins two coincident points and is left out. */
-ALWAYS_INLINE void grid_cell(__global uint *out, uint *count, uint base, pattern_grid g, int collapsed, int i, int j)
+POCL_INLINE void grid_cell(__global uint *out, uint *count, uint base, pattern_grid g, int collapsed, int i, int j)
 {
     uint a = grid_point_index(g, (int2)(i, j)), b = grid_point_index(g, (int2)(i + 1, j));
     uint c = grid_point_index(g, (int2)(i + 1, j + 1)), d = grid_point_index(g, (int2)(i, j + 1));
@@ -132,8 +132,8 @@ ALWAYS_INLINE void grid_cell(__global uint *out, uint *count, uint base, pattern
  * A row's inner cells are one loop without branches or a running count, six indices a cell
  * at out[3 count + 6 n ..] (so that a CPU compiler can unroll and vectorise it; stage 5 on
  * CPUs: bench/RESULTS.md, "Issue 15: CPU stage bandwidth" and "PoCL's stages, session 7"). */
-ALWAYS_INLINE void grid_cells(__global uint *out, uint *count, uint base, pattern_grid g, int collapsed,
-                              int i0, int i1, int j0, int j1)
+POCL_INLINE void grid_cells(__global uint *out, uint *count, uint base, pattern_grid g, int collapsed,
+                            int i0, int i1, int j0, int j1)
 {
     uint ring = (uint)(g.f.s0 + g.f.s1 + g.f.s2 + g.f.s3), inner = (uint)(g.core.x - 1);
     for (int j = j0; j < j1; ++j) {
