@@ -160,7 +160,10 @@ def _overlapped(tessellator, plan, ranges, forward_differencing: bool):
 
     def start(k, first, last):
         try:
-            return tessellator.emit_async(plan, first, last, forward_differencing, out=buffers[k % 2])
+            job = tessellator.emit_async(plan, first, last, forward_differencing, out=buffers[k % 2])
+            if hasattr(job, "start_read_back"):  # before the next batch's stages (in-order queue)
+                job.start_read_back()
+            return job
         except (cl.MemoryError, cl.RuntimeError) as error:
             if not _out_of_memory(error):
                 raise

@@ -74,6 +74,33 @@ def test_streamed_files_equal_single_pass_files(tessellator, tmp_path, suffix):
     assert (tmp_path / f"a{suffix}").read_bytes() == (tmp_path / f"b{suffix}").read_bytes()
 
 
+def test_each_batch_runs_its_stages_once(tessellator, tmp_path, monkeypatch):
+    """A streamed batch launches stages 4-5 once, its read-back enqueued right behind them.
+    (Sessions 8-10 ran every batch of a stream twice: the check for a frame launched on the
+    buffers' capacity took a batch's range for a plan's whole output, never fitting.)"""
+    from cltess.backends.opencl import output
+
+    scene = load_scene(SCENES / "teapot.bez")
+    launches, early = [], []
+    real_emit_async, real_start = tessellator.emit_async, output.OutputBuffers.start_read_back
+
+    def emit_async(plan, first, last, forward_differencing=True, out=None):
+        launches.append((first, last))
+        return real_emit_async(plan, first, last, forward_differencing, out)
+
+    def start_read_back(self, num_vertices, num_triangles):
+        early.append((num_vertices, num_triangles))
+        return real_start(self, num_vertices, num_triangles)
+
+    monkeypatch.setattr(tessellator, "emit_async", emit_async)
+    monkeypatch.setattr(output.OutputBuffers, "start_read_back", start_read_back)
+    result = tessellate_to_file(tessellator, scene, tmp_path / "a.ply", max_memory_bytes=900_000, eps=0.002)
+    assert result.batches > 3
+    assert launches == result.batch_ranges  # once each, in order
+    assert len(early) == result.batches
+    assert sum(vertices for vertices, _ in early) == result.stats["vertices"]
+
+
 @pytest.mark.parametrize("suffix", [".stl", ".glb"])
 def test_formats_that_do_not_stream_are_refused_before_writing(tessellator, tmp_path, suffix):
     scene = load_scene(SCENES / "teapot.bez")

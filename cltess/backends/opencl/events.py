@@ -6,12 +6,19 @@ import time
 import pyopencl as cl
 
 _START, _END = cl.profiling_info.START, cl.profiling_info.END
+_COMPLETE = cl.command_execution_status.COMPLETE
 
 
 def wait_ms(events) -> float:
-    """Wait for events; the host milliseconds spent blocked (a frame's wall_ms["waits"])."""
+    """Wait for events; the host milliseconds spent blocked (a frame's wall_ms["waits"]).
+
+    Events already complete are not waited for: Intel's CPU runtime lends the waiting thread
+    to whatever work is queued, so a wait on finished events still ran the next batch's
+    kernels on the host's thread before it returned (cltess.stream: the host waited about as
+    long as a batch's stages, every batch; bench/RESULTS.md, "Issue 15: session 11, lead")."""
     started = time.perf_counter()
-    cl.wait_for_events(events)
+    if not all(event.command_execution_status == _COMPLETE for event in events):
+        cl.wait_for_events(events)
     return (time.perf_counter() - started) * 1e3
 
 

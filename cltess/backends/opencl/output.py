@@ -98,6 +98,7 @@ class OutputBuffers:
         self.read_back_wait_ms = 0.0  # host ms blocked in the last read_back
         self._parent = None  # a mapped device's one allocation (_take_mapped), its fields' offsets
         self._offsets: dict = {}
+        self._started = None  # (generation, vertices, triangles, host arrays, events): start_read_back
         self._capacity = (0, 0)  # (vertices, triangles) of the buffers (_grow)
         self._field_buffers: dict = {}  # name -> device buffer (_grow)
 
@@ -168,8 +169,26 @@ class OutputBuffers:
             self._buffers[name] = (self._parent.get_sub_region(offsets[name], size), capacities[name])
         self._offsets = offsets
 
+    def start_read_back(self, num_vertices: int, num_triangles: int) -> None:
+        """Enqueue the current generation's read-back now, without waiting; ``read_back`` of
+        the same sizes then only waits for it.  The queue is in order: a read-back enqueued
+        when the host asks for it would wait behind whatever was enqueued since, e.g. the
+        next batch's stages (cltess.stream), so host and device could never overlap."""
+        self._started = (self.generation, num_vertices, num_triangles,
+                         *self._enqueue_read_back(num_vertices, num_triangles))
+
     def read_back(self, num_vertices: int, num_triangles: int) -> dict:
         """The current generation's output as host arrays (see the class)."""
+        started, self._started = self._started, None
+        if started is not None and started[:3] == (self.generation, num_vertices, num_triangles):
+            host, events = started[3:]
+        else:
+            host, events = self._enqueue_read_back(num_vertices, num_triangles)
+        self.read_back_wait_ms = wait_ms(events) if events else 0.0
+        return host
+
+    def _enqueue_read_back(self, num_vertices: int, num_triangles: int) -> tuple[dict, list]:
+        """(host arrays, the events to wait for before reading them): the maps or copies enqueued."""
         host, events = {}, []
         if self.mapped:  # one map of the whole allocation; each field a view of it
             memory, event = cl.enqueue_map_buffer(self.queue, self._parent, cl.map_flags.READ | cl.map_flags.WRITE,
@@ -180,26 +199,18 @@ class OutputBuffers:
                 start = self._offsets[name]
                 host[name] = memory[start:start + rows * dtype.itemsize * math.prod(shape)].view(dtype) \
                     .reshape(rows, *shape)
-            self.read_back_wait_ms = wait_ms([event])
-            return host
+            return host, [event]
         for name, dtype, shape in self._layout():
             rows = num_triangles if name == "triangles" else num_vertices
             buffer, capacity = self._buffers[name]
             if not rows:
                 host[name] = np.zeros((0, *shape), dtype)
-            elif self.mapped:
-                array, event = cl.enqueue_map_buffer(self.queue, buffer, cl.map_flags.READ | cl.map_flags.WRITE, 0,
-                                                     (rows, *shape), dtype, is_blocking=False)
-                self._maps.append(array.base)  # the pyopencl MemoryMap
-                host[name] = array
-                events.append(event)
             else:
                 target = self._pinned(name, dtype, shape, capacity)[:rows] if self.pinned \
                     else np.empty((rows, *shape), dtype)
                 events.append(cl.enqueue_copy(self.queue, target, buffer, is_blocking=False))
                 host[name] = target
-        self.read_back_wait_ms = wait_ms(events) if events else 0.0
-        return host
+        return host, events
 
     def unmap(self) -> None:
         """Unmap the host views of the last generation (before the device writes the buffers

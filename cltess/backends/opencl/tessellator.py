@@ -1077,6 +1077,15 @@ class PendingEmit:
     strips: np.ndarray | None = None  # host strips of a strip pattern (cltess.strips)
     forward_differencing: bool | None = None  # as asked of emit_async (a run again asks the same)
 
+    def start_read_back(self) -> None:
+        """Enqueue the host read-back (and the factors' copy) now, right behind these stages,
+        so that ``result()`` only waits for it: what the host enqueues meanwhile (the next
+        batch's stages: cltess.stream) then runs while the host reads this output.  Only for a
+        settled plan, whose sizes are known (a Session frame's may still run again)."""
+        if self.plan.settled:
+            self.plan.enqueue_host_factors()
+            self.buffers.start_read_back(self.arrays.num_vertices, self.arrays.num_triangles)
+
     def result(self, on_device: bool = False, wait: bool = True) -> Tessellation:
         """The Tessellation.  wait=False (with on_device): return at once, the stages still
         running; the first look at its ``stage_ms``, ``wall_ms``, ``stats``, sizes or arrays,
@@ -1097,11 +1106,12 @@ class PendingEmit:
             if plan.settled and "stats" in times:
                 return
             plan.settle()
+            times["stats"] = dict(plan.stats, first_patch=first, last_patch=last)
+            if not launched_on_capacity:  # launched on the settled plan's sizes (of this range)
+                return
             arrays = current["arrays"]
             fits = plan.num_vertices <= arrays.num_vertices and plan.num_indices // 3 <= arrays.num_triangles
-            times["stats"] = dict(plan.stats, first_patch=first, last_patch=last)
-            if launched_on_capacity:  # False: the first launch of stages 4-5 wrote nothing (too small)
-                times["stats"]["output_fit"] = fits
+            times["stats"]["output_fit"] = fits  # False: the first launch of stages 4-5 wrote nothing (too small)
             if fits or buffers.generation != current["generation"]:  # (stale: its sizes, never its arrays)
                 arrays.num_vertices, arrays.num_triangles = plan.num_vertices, plan.num_indices // 3
             else:
