@@ -22,6 +22,12 @@ less than the wall clock.
 Then the same steps timed one by one in this process (warm kernels), to show where the time
 goes.
 
+The children run with compiled bytecode, as a user's install has it (``pip`` compiles it; an
+editable install writes it on first import): ``PYTHONDONTWRITEBYTECODE`` is dropped from their
+environment and each tree's bytecode goes to its own ``PYTHONPYCACHEPREFIX`` folder, filled by an
+untimed first run.  ``--source`` keeps this shell's setting instead (a checkout started with
+``PYTHONDONTWRITEBYTECODE=1`` compiles cltess's sources at every start: 0.05-0.1 s more).
+
 Each tree writes its own PLY (``out.ply``, ``out-baseline.ply``): a buffered writer that
 replaces a file the other tree wrote through the page cache reuses the 556 MB of pages that
 file's removal has just freed, which on this VM (free page reporting: freed memory goes back to
@@ -190,6 +196,9 @@ def main() -> int:
                         help="seconds to wait before every child run (memory freed by the last run is "
                              "then no longer reused: a single run's conditions); default 0")
     parser.add_argument("--states", default="cold,warm", help="which of cold,warm to run (default both)")
+    parser.add_argument("--source", action="store_true",
+                        help="run the children as this shell sets PYTHONDONTWRITEBYTECODE (default: with "
+                             "compiled bytecode, as an installed cltess)")
     args = parser.parse_args()
     SPACING[0] = args.spacing
     with tempfile.TemporaryDirectory(dir=args.folder or ".") as folder:
@@ -202,15 +211,23 @@ def main() -> int:
         base = common + ["-o", str(out)]
         baseline_args = common + ["-o", str(base_out)]
         print(f"{scene.name}: {scene.stat().st_size / 1e6:.1f} MB; load average {os.getloadavg()}; "
-              f"spacing {args.spacing:g} s")
+              f"spacing {args.spacing:g} s; {'sources compiled at each start' if args.source else 'compiled bytecode'}")
         rows, cpu, loads = {}, {}, {}
         peer = folder / "peer.bin"
+        shell = dict(os.environ)
+        if not args.source:  # compiled bytecode per tree, compiled by an untimed run of each
+            shell.pop("PYTHONDONTWRITEBYTECODE", None)
+            for tree, name in ((TREE, "tree"), (args.baseline, "baseline")):
+                if tree:
+                    env = dict(shell, PYTHONPATH=str(Path(tree).resolve()), CLTESS_SCENE_CACHE="off",
+                               PYTHONPYCACHEPREFIX=str(folder / f"pycache-{name}"))
+                    run_cli([str(scene), *common, "-o", str(folder / "compile.ply")], env)
         for orient in ("--orient", "--no-orient"):
             for state in [state for state in ("cold", "warm") if state in args.states.split(",")]:
                 walls, baseline, peers, imports = [], [], [], []
                 for _ in range(args.repeat):
                     cache = folder / f"cache-{orient}-{len(walls)}"  # cold: a fresh cache each run
-                    env = dict(os.environ, PYTHONPATH=str(TREE),
+                    env = dict(shell, PYTHONPATH=str(TREE), PYTHONPYCACHEPREFIX=str(folder / "pycache-tree"),
                                CLTESS_SCENE_CACHE=str(cache if state == "cold" else folder / "cache"))
                     if state == "warm" and not walls:
                         run_cli([str(scene), orient, *base], env)  # fills the warm cache
@@ -221,6 +238,7 @@ def main() -> int:
                         base_cache = folder / (f"cache-baseline-{orient}-{len(walls)}" if state == "cold"
                                                else "cache-baseline")
                         base_env = dict(env, PYTHONPATH=str(Path(args.baseline).resolve()),
+                                        PYTHONPYCACHEPREFIX=str(folder / "pycache-baseline"),
                                         CLTESS_SCENE_CACHE=str(base_cache))
                         if state == "warm" and not baseline:
                             run_cli([str(scene), orient, *baseline_args], base_env)  # fills its warm cache
