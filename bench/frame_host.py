@@ -12,8 +12,9 @@ frame records
 * device ms: the sum of the stages' OpenCL profiling spans;
 * "on device": wall ms of ``session.tessellate(camera=...)``, until the stages are done and the
   output is on the device;
-* "host arrays": wall ms of ``session.tessellate(camera=...).fetch()``, until the caller holds
-  host arrays (a mapping on a CPU device, a copy through page-locked memory on a GPU);
+* "host arrays": wall ms of ``session.tessellate(camera=..., host=True).fetch()`` (a tree
+  before ``host=``: ``session.tessellate(camera=...).fetch()``), until the caller holds host
+  arrays (a mapping on a CPU device, a copy through page-locked memory on a GPU);
 * "(host)" after each: that wall minus the ms blocked in ``pyopencl.wait_for_events`` (patched
   in the child to time it, in both trees): the host's own work per frame;
 * "looped", "overlap" (a tree with ``Session.tessellate(wait=False)``): a loop over the cameras
@@ -85,6 +86,7 @@ def child(args) -> dict:
 
     cl.wait_for_events = timed_wait
     overlaps = "wait" in inspect.signature(cltess.Session.tessellate).parameters
+    host_frames = "host" in inspect.signature(cltess.Session.tessellate).parameters
     from cltess.backends.opencl import Tessellator
     from cltess.bench.suite import device_info, resolve_scenes
 
@@ -109,7 +111,10 @@ def child(args) -> dict:
         for camera in path:
             waited[0] = 0
             started = time.perf_counter()
-            session.tessellate(camera=camera).fetch()
+            if host_frames:  # the read-back enqueued with the stages
+                session.tessellate(camera=camera, host=True).fetch()
+            else:
+                session.tessellate(camera=camera).fetch()
             held.append((time.perf_counter() - started) * 1e3)
             held_host.append(held[-1] - waited[0] / 1e6)
         row = {"scene": key, "triangles": frame.num_triangles, "device_ms": statistics.median(device),

@@ -173,7 +173,10 @@ def frames(session, cameras, host: bool, **overrides) -> list[dict]:
     host work: Python, launches, copies' set-up)."""
     out = []
     for camera in cameras:
-        frame = session.tessellate(camera=camera, **overrides)
+        if host and HOST_FRAMES:  # the read-back enqueued with the stages (Session.tessellate(host=True))
+            frame = session.tessellate(camera=camera, host=True, **overrides)
+        else:
+            frame = session.tessellate(camera=camera, **overrides)
         if host:
             frame.fetch()
         total = frame.wall_ms.get("total", frame.wall_ms["stages"])
@@ -294,6 +297,9 @@ def frame_loop(tessellator, key: str, count: int) -> dict:
 #: Whether this cltess has Session.tessellate(wait=False) (the script also runs on older trees
 #: through PYTHONPATH, for before/after figures).
 OVERLAPS = "wait" in inspect.signature(cltess.Session.tessellate).parameters
+#: Whether it has Session.tessellate(host=True) (frames for host arrays: the read-back enqueued
+#: with the stages); the "host arrays" figures use it where there, else tessellate() and fetch().
+HOST_FRAMES = "host" in inspect.signature(cltess.Session.tessellate).parameters
 
 
 def frame_report(record: dict) -> list[str]:

@@ -62,6 +62,35 @@ def test_session_frames_are_bitwise_the_one_shot_results(tessellator, tea_table)
     assert session.frames == 4
 
 
+def test_host_frames_read_back_with_their_stages(tessellator, tea_table, monkeypatch):
+    """tessellate(host=True): host arrays bitwise those of fetch(); on a CPU device the map is
+    enqueued with the stages (read_back then waits for it, enqueueing none), also for a frame
+    that outgrows the buffers (its stages run again: the early map is dropped) and with
+    wait=False (fetched on first use)."""
+    from cltess.backends.opencl import output
+
+    maps = []
+    real_map = output.OutputBuffers._enqueue_map
+    session = cltess.Session(tea_table, tessellator=tessellator, pixels=0.5)
+    monkeypatch.setattr(output.OutputBuffers, "_enqueue_map",
+                        lambda self: (self is session.output and maps.append(1)) or real_map(self))
+    plain = cltess.Session(tea_table, tessellator=tessellator, pixels=0.5)
+    fits = []
+    for k, camera in enumerate(orbit(tea_table, 4)):  # nearer each time: the output grows
+        maps.clear()
+        frame = session.tessellate(camera=camera, host=True, wait=k % 2 == 0)
+        assert frame.device is not None
+        if session.output.mapped and k % 2:  # enqueued with the stages, before anything waited
+            assert len(maps) == 1 and "_finish" in frame.__dict__
+        expected = plain.tessellate(camera=camera).fetch()
+        assert_same_output(frame, expected)
+        assert np.array_equal(frame.factors, expected.factors)
+        fits.append(frame.stats.get("output_fit", True))
+        if session.output.mapped:  # one map, or two where the stages ran again on grown buffers
+            assert len(maps) == (1 if fits[-1] else 2)
+    assert False in fits  # (the case of stages run again is covered)
+
+
 def test_session_overrides_and_growing_buffers(tessellator, tea_table):
     session = cltess.Session(tea_table, tessellator=tessellator, eps=0.02)
     coarse = session.tessellate()

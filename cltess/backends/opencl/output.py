@@ -98,7 +98,7 @@ class OutputBuffers:
         self.read_back_wait_ms = 0.0  # host ms blocked in the last read_back
         self._parent = None  # a mapped device's one allocation (_take_mapped), its fields' offsets
         self._offsets: dict = {}
-        self._started = None  # (generation, vertices, triangles, host arrays, events): start_read_back
+        self._started = None  # (generation, vertices, triangles, what was enqueued): start_read_back
         self._capacity = (0, 0)  # (vertices, triangles) of the buffers (_grow)
         self._field_buffers: dict = {}  # name -> device buffer (_grow)
 
@@ -169,37 +169,56 @@ class OutputBuffers:
             self._buffers[name] = (self._parent.get_sub_region(offsets[name], size), capacities[name])
         self._offsets = offsets
 
-    def start_read_back(self, num_vertices: int, num_triangles: int) -> None:
-        """Enqueue the current generation's read-back now, without waiting; ``read_back`` of
-        the same sizes then only waits for it.  The queue is in order: a read-back enqueued
-        when the host asks for it would wait behind whatever was enqueued since, e.g. the
-        next batch's stages (cltess.stream), so host and device could never overlap."""
-        self._started = (self.generation, num_vertices, num_triangles,
-                         *self._enqueue_read_back(num_vertices, num_triangles))
+    def start_read_back(self, num_vertices: int | None = None, num_triangles: int | None = None) -> None:
+        """Enqueue the current generation's read-back now, without waiting; ``read_back`` then
+        only waits for it.  The queue is in order: a read-back enqueued when the host asks for
+        it waits behind whatever was enqueued since (the next batch's stages: cltess.stream),
+        and costs the host a round trip of its own after the stages' (a Session frame).  A CPU
+        device's map covers the whole allocation, so the sizes may be left out (a frame whose
+        totals are still on their way); copies need them (else nothing is started)."""
+        if self.mapped:
+            self._started = (self.generation, None, None, self._enqueue_map())
+        elif num_vertices is not None:
+            self._started = (self.generation, num_vertices, num_triangles,
+                             self._enqueue_copies(num_vertices, num_triangles))
 
     def read_back(self, num_vertices: int, num_triangles: int) -> dict:
         """The current generation's output as host arrays (see the class)."""
         started, self._started = self._started, None
-        if started is not None and started[:3] == (self.generation, num_vertices, num_triangles):
-            host, events = started[3:]
+        if started is not None and started[0] == self.generation and started[1] in (None, num_vertices) \
+                and started[2] in (None, num_triangles):
+            enqueued = started[3]
         else:
-            host, events = self._enqueue_read_back(num_vertices, num_triangles)
+            enqueued = self._enqueue_map() if self.mapped else self._enqueue_copies(num_vertices, num_triangles)
+        if self.mapped:  # each field a view of the one mapping
+            memory, event = enqueued
+            host, events = self._views(memory, num_vertices, num_triangles), [event]
+        else:
+            host, events = enqueued
         self.read_back_wait_ms = wait_ms(events) if events else 0.0
         return host
 
-    def _enqueue_read_back(self, num_vertices: int, num_triangles: int) -> tuple[dict, list]:
-        """(host arrays, the events to wait for before reading them): the maps or copies enqueued."""
+    def _enqueue_map(self):
+        """(memory, event): one map of the whole allocation (a CPU device), not waited for."""
+        memory, event = cl.enqueue_map_buffer(self.queue, self._parent, cl.map_flags.READ | cl.map_flags.WRITE,
+                                              0, (self._parent.size,), np.uint8, is_blocking=False)
+        self._maps.append(memory.base)  # the pyopencl MemoryMap
+        return memory, event
+
+    def _views(self, memory, num_vertices: int, num_triangles: int) -> dict:
+        """Each field's host array: a view of the mapped allocation."""
+        host = {}
+        for name, dtype, shape in self._layout():
+            rows = num_triangles if name == "triangles" else num_vertices
+            start = self._offsets[name]
+            host[name] = memory[start:start + rows * dtype.itemsize * math.prod(shape)].view(dtype) \
+                .reshape(rows, *shape)
+        return host
+
+    def _enqueue_copies(self, num_vertices: int, num_triangles: int) -> tuple[dict, list]:
+        """(host arrays, the events to wait for before reading them): each field's copy enqueued
+        (into its page-locked array, or a fresh one)."""
         host, events = {}, []
-        if self.mapped:  # one map of the whole allocation; each field a view of it
-            memory, event = cl.enqueue_map_buffer(self.queue, self._parent, cl.map_flags.READ | cl.map_flags.WRITE,
-                                                  0, (self._parent.size,), np.uint8, is_blocking=False)
-            self._maps.append(memory.base)  # the pyopencl MemoryMap
-            for name, dtype, shape in self._layout():
-                rows = num_triangles if name == "triangles" else num_vertices
-                start = self._offsets[name]
-                host[name] = memory[start:start + rows * dtype.itemsize * math.prod(shape)].view(dtype) \
-                    .reshape(rows, *shape)
-            return host, [event]
         for name, dtype, shape in self._layout():
             rows = num_triangles if name == "triangles" else num_vertices
             buffer, capacity = self._buffers[name]
