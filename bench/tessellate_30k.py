@@ -80,6 +80,14 @@ TREE = Path(__file__).resolve().parent.parent
 CHILD_FOLDER = [None]
 
 
+def python_path(tree) -> str:
+    """PYTHONPATH for a child running ``tree``'s cltess: the tree, then this environment's entries
+    that hold no cltess of their own (e.g. the GPU machine's folder of installed wheels)."""
+    kept = [entry for entry in os.environ.get("PYTHONPATH", "").split(os.pathsep)
+            if entry and not (Path(entry) / "cltess").is_dir()]
+    return os.pathsep.join([str(Path(tree).resolve()), *kept])
+
+
 def run_child(command: list[str], env: dict) -> float:
     """Wall seconds of a child process; its CPU seconds (user + system, all its threads) are
     appended to CPU_SECONDS."""
@@ -219,7 +227,7 @@ def main() -> int:
             shell.pop("PYTHONDONTWRITEBYTECODE", None)
             for tree, name in ((TREE, "tree"), (args.baseline, "baseline")):
                 if tree:
-                    env = dict(shell, PYTHONPATH=str(Path(tree).resolve()), CLTESS_SCENE_CACHE="off",
+                    env = dict(shell, PYTHONPATH=python_path(tree), CLTESS_SCENE_CACHE="off",
                                PYTHONPYCACHEPREFIX=str(folder / f"pycache-{name}"))
                     run_cli([str(scene), *common, "-o", str(folder / "compile.ply")], env)
         for orient in ("--orient", "--no-orient"):
@@ -227,7 +235,7 @@ def main() -> int:
                 walls, baseline, peers, imports = [], [], [], []
                 for _ in range(args.repeat):
                     cache = folder / f"cache-{orient}-{len(walls)}"  # cold: a fresh cache each run
-                    env = dict(shell, PYTHONPATH=str(TREE), PYTHONPYCACHEPREFIX=str(folder / "pycache-tree"),
+                    env = dict(shell, PYTHONPATH=python_path(TREE), PYTHONPYCACHEPREFIX=str(folder / "pycache-tree"),
                                CLTESS_SCENE_CACHE=str(cache if state == "cold" else folder / "cache"))
                     if state == "warm" and not walls:
                         run_cli([str(scene), orient, *base], env)  # fills the warm cache
@@ -237,7 +245,7 @@ def main() -> int:
                     if args.baseline:  # its own caches: a fresh one (cold), its warm one (warm)
                         base_cache = folder / (f"cache-baseline-{orient}-{len(walls)}" if state == "cold"
                                                else "cache-baseline")
-                        base_env = dict(env, PYTHONPATH=str(Path(args.baseline).resolve()),
+                        base_env = dict(env, PYTHONPATH=python_path(args.baseline),
                                         PYTHONPYCACHEPREFIX=str(folder / "pycache-baseline"),
                                         CLTESS_SCENE_CACHE=str(base_cache))
                         if state == "warm" and not baseline:
