@@ -170,7 +170,7 @@ class Session:
             programs.recording = None
         self._plans = [*self._plans[-1:], pending.plan]
         self.frames += 1
-        if host:  # (a GPU's copies need the totals: there the read-back starts when they are known)
+        if host:  # (a GPU's copies need the totals: there fetch enqueues them, after the stages)
             pending.plan.enqueue_host_factors()
             self.output.start_read_back()
         frame = pending.result(on_device=True, wait=wait)

@@ -15,7 +15,7 @@ def wait_ms(events) -> float:
     Events already complete are not waited for: Intel's CPU runtime lends the waiting thread
     to whatever work is queued, so a wait on finished events still ran the next batch's
     kernels on the host's thread before it returned (cltess.stream: the host waited about as
-    long as a batch's stages, every batch; bench/RESULTS.md, "Issue 15: session 11, lead")."""
+    long as a batch's stages, every batch; bench/RESULTS.md, "Session 11, lead")."""
     started = time.perf_counter()
     if not all(event.command_execution_status == _COMPLETE for event in events):
         cl.wait_for_events(events)
