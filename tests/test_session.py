@@ -91,6 +91,23 @@ def test_host_frames_read_back_with_their_stages(tessellator, tea_table, monkeyp
     assert False in fits  # (the case of stages run again is covered)
 
 
+def test_one_shot_results_start_their_read_back_with_their_stages(tessellator, tea_table, monkeypatch):
+    """emit() of host arrays enqueues their read-back right behind the stages (one wait for
+    both); emit(on_device=True) reads nothing back until asked."""
+    from cltess.backends.opencl import output
+
+    started = []
+    real = output.OutputBuffers.start_read_back
+    monkeypatch.setattr(output.OutputBuffers, "start_read_back",
+                        lambda self, *sizes: started.append(sizes) or real(self, *sizes))
+    tess = tessellator.tessellate(tea_table, pixels=0.5)
+    assert started == [(tess.num_vertices, tess.num_triangles)] and tess.on_host
+    plan = tessellator.plan(tea_table, pixels=0.5)
+    resident = tessellator.emit(plan, 0, plan.num_patches, on_device=True)
+    assert len(started) == 1 and not resident.on_host
+    assert_same_output(resident.fetch(), tess)
+
+
 def test_session_overrides_and_growing_buffers(tessellator, tea_table):
     session = cltess.Session(tea_table, tessellator=tessellator, eps=0.02)
     coarse = session.tessellate()

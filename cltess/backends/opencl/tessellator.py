@@ -592,7 +592,10 @@ class Tessellator:
         device by mapping the buffers: no copy).  out: output buffers to write into (grown as
         needed; a ``Session`` reuses its own), else fresh ones.  A request with emit="by_level"
         runs them by level (levels.emit_by_level, without forward differencing, read back now)."""
-        return self.emit_async(plan, first, last, forward_differencing, out).result(on_device)
+        job = self.emit_async(plan, first, last, forward_differencing, out)
+        if not on_device and isinstance(job, PendingEmit):  # read back now: enqueued behind the stages
+            job.start_read_back()
+        return job.result(on_device)
 
     def emit_async(self, plan: "Plan", first: int, last: int, forward_differencing: bool | None = None,
                    out: "OutputBuffers | None" = None) -> "PendingEmit":
