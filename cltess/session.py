@@ -171,8 +171,7 @@ class Session:
         self._plans = [*self._plans[-1:], pending.plan]
         self.frames += 1
         if host:  # (a GPU's copies need the totals: there fetch enqueues them, after the stages)
-            pending.plan.enqueue_host_factors()
-            self.output.start_read_back()
+            pending.start_read_back()
         frame = pending.result(on_device=True, wait=wait)
         return frame.fetch() if host and wait else frame
 

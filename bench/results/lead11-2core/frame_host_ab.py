@@ -12,7 +12,7 @@ path = list(fl.orbit(scene.camera, 20))
 for c in path: s.tessellate(camera=c).fetch()
 res = {"late": [], "early": []}
 for r in range(30):
-    for name in res:
+    for name in (list(res) if r % 2 == 0 else list(res)[::-1]):  # the order swapped each round
         for c in path:
             a = time.perf_counter_ns()
             if name == "late":

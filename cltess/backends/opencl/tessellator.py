@@ -1083,11 +1083,17 @@ class PendingEmit:
     def start_read_back(self) -> None:
         """Enqueue the host read-back (and the factors' copy) now, right behind these stages,
         so that ``result()`` only waits for it: what the host enqueues meanwhile (the next
-        batch's stages: cltess.stream) then runs while the host reads this output.  Only for a
-        settled plan, whose sizes are known (a Session frame's may still run again)."""
-        if self.plan.settled:
+        batch's stages: cltess.stream) then runs while the host reads this output, and the
+        read-back costs no round trip of its own.  A CPU device's map needs no sizes, so it is
+        started also for a Session frame whose totals are still on their way; a GPU's copies
+        need them: there only for a settled plan."""
+        buffers = self.buffers
+        if buffers.mapped:
             self.plan.enqueue_host_factors()
-            self.buffers.start_read_back(self.arrays.num_vertices, self.arrays.num_triangles)
+            buffers.start_read_back()
+        elif self.plan.settled:
+            self.plan.enqueue_host_factors()
+            buffers.start_read_back(self.arrays.num_vertices, self.arrays.num_triangles)
 
     def result(self, on_device: bool = False, wait: bool = True) -> Tessellation:
         """The Tessellation.  wait=False (with on_device): return at once, the stages still
