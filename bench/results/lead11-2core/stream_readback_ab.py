@@ -10,8 +10,8 @@ scene = load_scene("scene.bpt"); scene, _ = orient_scene(scene)
 t = Tessellator()
 keep = tm.PendingEmit.start_read_back
 res = {"early": [], "late": []}
-for r in range(8):
-    for v in ("early", "late"):
+for r in range(12):
+    for v in (("early", "late") if r % 2 == 0 else ("late", "early")):  # the order swapped each round
         tm.PendingEmit.start_read_back = keep if v == "early" else (lambda self: None)
         s = time.perf_counter(); c0 = resource.getrusage(resource.RUSAGE_SELF)
         stream.tessellate_to_file(t, scene, "out-x.ply", eps=0.0085)
