@@ -161,8 +161,7 @@ def _overlapped(tessellator, plan, ranges, forward_differencing: bool):
     def start(k, first, last):
         try:
             job = tessellator.emit_async(plan, first, last, forward_differencing, out=buffers[k % 2])
-            if hasattr(job, "start_read_back"):  # before the next batch's stages (in-order queue)
-                job.start_read_back()
+            job.start_read_back()  # before the next batch's stages (in-order queue)
             return job
         except (cl.MemoryError, cl.RuntimeError) as error:
             if not _out_of_memory(error):

@@ -593,7 +593,7 @@ class Tessellator:
         needed; a ``Session`` reuses its own), else fresh ones.  A request with emit="by_level"
         runs them by level (levels.emit_by_level, without forward differencing, read back now)."""
         job = self.emit_async(plan, first, last, forward_differencing, out)
-        if not on_device and isinstance(job, PendingEmit):  # read back now: enqueued behind the stages
+        if not on_device:  # read back now: enqueued behind the stages
             job.start_read_back()
         return job.result(on_device)
 
@@ -1056,9 +1056,12 @@ def combine_verified(parts: list[dict]) -> dict:
 
 @dataclass
 class _Ready:
-    """An emit that ran synchronously, with PendingEmit's ``result``."""
+    """An emit that ran synchronously, with PendingEmit's ``start_read_back`` and ``result``."""
 
     tessellation: Tessellation
+
+    def start_read_back(self) -> None:  # (read back already)
+        pass
 
     def result(self, on_device: bool = False, wait: bool = True) -> Tessellation:
         return self.tessellation
@@ -1087,13 +1090,14 @@ class PendingEmit:
         read-back costs no round trip of its own.  A CPU device's map needs no sizes, so it is
         started also for a Session frame whose totals are still on their way; a GPU's copies
         need them: there only for a settled plan."""
-        buffers = self.buffers
-        if buffers.mapped:
-            self.plan.enqueue_host_factors()
-            buffers.start_read_back()
+        if self.buffers.mapped:
+            sizes = ()
         elif self.plan.settled:
-            self.plan.enqueue_host_factors()
-            buffers.start_read_back(self.arrays.num_vertices, self.arrays.num_triangles)
+            sizes = (self.arrays.num_vertices, self.arrays.num_triangles)
+        else:
+            return
+        self.plan.enqueue_host_factors()
+        self.buffers.start_read_back(*sizes)
 
     def result(self, on_device: bool = False, wait: bool = True) -> Tessellation:
         """The Tessellation.  wait=False (with on_device): return at once, the stages still
