@@ -20,6 +20,12 @@ frame records
 * "looped", "overlap" (a tree with ``Session.tessellate(wait=False)``): a loop over the cameras
   with frames that wait and with frames that overlap, the loop's wall clock over its frames
   until the last one is finished (``frame_loop.overlapped``);
+* "piped", "ratio" (a tree with ``Session(buffers=2)``): host-array frames pipelined on two
+  buffer sets, frame k+1 enqueued (``host=True, wait=False``) before frame k's arrays are
+  fetched, as a renderer that uses frame k while the device computes frame k+1: the loop's wall
+  clock per frame until the last frame's arrays are held (median of 3 loops), over the *device*
+  column (the waited frames' device time: on a CPU device the pipelined frames' own device time
+  rises, their kernels sharing the cores with the host's work);
 * "host µs": the host thread's CPU time per overlapped frame less its CPU time in waits (the
   smallest of the children's medians): the frame's own host work, Python and the runtime's
   calls, measured by CPU time so that on a CPU device the device's threads do not count;
@@ -84,8 +90,30 @@ def child(args) -> dict:
             waits.append(waited[0] / len(path) / 1e3)
         return statistics.median(loops), statistics.median(waits)
 
+    def piped(scene, path, rounds: int = 3) -> tuple[float, float]:
+        """(wall ms per frame, median device ms) of host-array frames pipelined on two buffer sets
+        (the module's "piped"), median of ``rounds`` loops, after a pass that sizes and records
+        both sets."""
+        session = cltess.Session(scene, tessellator=tessellator, pixels=fl.PIXELS, buffers=2)
+        for camera in path:
+            session.tessellate(camera=camera, host=True)
+        walls, device = [], []
+        for _ in range(rounds):
+            started = time.perf_counter()
+            previous = session.tessellate(camera=path[0], host=True, wait=False)
+            for camera in path[1:]:
+                frame = session.tessellate(camera=camera, host=True, wait=False)
+                previous.fetch()
+                device.append(fl.device_ms(previous))
+                previous = frame
+            previous.fetch()
+            device.append(fl.device_ms(previous))
+            walls.append((time.perf_counter() - started) / len(path) * 1e3)
+        return statistics.median(walls), statistics.median(device)
+
     cl.wait_for_events = timed_wait
     overlaps = "wait" in inspect.signature(cltess.Session.tessellate).parameters
+    pipelines = "buffers" in inspect.signature(cltess.Session).parameters
     host_frames = "host" in inspect.signature(cltess.Session.tessellate).parameters
     from cltess.backends.opencl import Tessellator
     from cltess.bench.suite import device_info, resolve_scenes
@@ -123,6 +151,8 @@ def child(args) -> dict:
         if overlaps:
             row.update(fl.overlapped(session, path))
             row["overlapped_host_cpu_us"], row["overlapped_wait_us"] = overlapped_host_cpu(session, path)
+        if pipelines:
+            row["piped_wall_ms"], row["piped_device_ms"] = piped(scene, path)
         rows.append(row)
     record = {"device": device_info(tessellator.device), "rows": rows, "cltess": cltess.__file__}
     if args.grid:
@@ -176,7 +206,8 @@ def main() -> int:
     header = f"{'scene':20} {'triangles':>10}"
     for name in trees:
         header += (f" | {name + ' device':>14} {'on device':>10} {'(host)':>7} {'ratio':>6} {'host arr.':>10} {'(host)':>7}"
-                   f" {'ratio':>6} {'looped':>8} {'overlap':>8} {'ratio':>6} {'host µs':>8} {'waits µs':>8}")
+                   f" {'ratio':>6} {'looped':>8} {'overlap':>8} {'ratio':>6} {'host µs':>8} {'waits µs':>8}"
+                   f" {'piped':>8} {'ratio':>6}")
     print(header)
     result = {"device": device, "load": [load_before, os.getloadavg()], "command": " ".join(sys.argv), "scenes": []}
     for index, row in enumerate(runs["this"][0]["rows"]):
@@ -194,6 +225,10 @@ def main() -> int:
                          f" {best['overlapped_wait_us']:>8.1f}")
             else:
                 line += f" {'-':>8} {'-':>8} {'-':>6} {'-':>8} {'-':>8}"
+            if "piped_wall_ms" in best:
+                line += f" {best['piped_wall_ms']:>8.3f} {best['piped_wall_ms'] / best['device_ms']:>5.2f}x"
+            else:
+                line += f" {'-':>8} {'-':>6}"
             entry[name] = best
         print(line)
         result["scenes"].append(entry)

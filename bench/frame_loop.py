@@ -215,6 +215,14 @@ def overlapped(session, cameras, rounds: int = 3) -> dict:
             "overlapped_device_ms": statistics.median(device), "frames_not_fit": not_fit}
 
 
+def session_scratch(session, key) -> dict:
+    """The per-patch arrays of stages 1-3 that a Session's first buffer set keeps for ``key`` (a
+    tree before ``Session(buffers=)``: the session's one dict of them)."""
+    if hasattr(session, "_sets"):
+        return session._sets[0].scratch.setdefault(key, {})
+    return session._scratch.setdefault(key, {})
+
+
 def host_parts(session, cameras, rounds: int = 3) -> dict:
     """A frame's host time split into its steps (``Session.tessellate``'s, one by one), median
     µs over the frames: the request for the camera, program look-up (skipped for a new camera
@@ -248,7 +256,8 @@ def host_parts(session, cameras, rounds: int = 3) -> dict:
                 if getattr(session, "_composed", None) is None:  # (a tree before the skip: every frame)
                     tessellator.compose(session.scene, request)
                 t2 = clock()
-                plan = tessellator.plan_on(session._scene_data[key], request, None, session._scratch[key], **deferred)
+                plan = tessellator.plan_on(session._scene_data[key], request, None, session_scratch(session, key),
+                                           **deferred)
                 t3 = clock()
                 totals = sum(waits)
                 pending = tessellator.emit_async(plan, 0, plan.num_patches, out=session.output)

@@ -30,11 +30,18 @@ buffers (no copy), on a GPU by a copy into the pinned buffers.  Either way they 
 the session's buffers*: valid until the next ``tessellate`` call, which reuses them (a stale
 frame's ``device`` and ``fetch`` raise ``StaleOutput``; host arrays already taken are simply
 overwritten, as a renderer's frame buffers are).  ``.copy()`` what must outlive the frame.
+
+``Session(..., buffers=2)`` keeps two sets of those buffers (and of the per-patch arrays of
+stages 1-3), which frames take in turn, as a renderer double-buffers: a frame's output then stays
+valid until the second ``tessellate`` call after it, so the host can use frame k's arrays while
+the device computes frame k+1 (``tessellate(camera, host=True, wait=False)``, then the previous
+frame's ``fetch()``).  Twice the output memory; each set grows when its own turn comes.
 """
 from __future__ import annotations
 
 import dataclasses
 import time
+from dataclasses import dataclass, field
 
 from .backends.opencl.recorded import RecordedFrame
 from .backends.opencl.output import OutputBuffers
@@ -45,27 +52,52 @@ from .scene import Camera, Scene
 from .tessellation import Tessellation
 
 
+@dataclass
+class FrameBuffers:
+    """What a frame writes, one set of it (``Session(buffers=N)`` keeps N, taken in turn): the
+    output buffers, the per-patch arrays of stages 1-3 (a frame whose output did not fit runs
+    stages 4-5 again from them), and the last frame made on them for the session's request,
+    to replay (``RecordedFrame``: its launches name these buffers)."""
+
+    output: OutputBuffers
+    scratch: dict = field(default_factory=dict)  # sharp_edges -> the per-patch arrays of stages 1-3
+    recorded: RecordedFrame | None = None
+
+
 class Session:
     """Tessellate one scene per frame on one OpenCL device, keeping its device data.
 
     scene: the scene; device: an OpenCL device or its name (``cltess.device.pick_device``), or
     give ``tessellator`` (to share its context and programs); request: a ``Request``, or its
-    parts as keywords (``Request.of``: eps= or pixels=, max_factor=, pattern=, ...).
+    parts as keywords (``Request.of``: eps= or pixels=, max_factor=, pattern=, ...).  buffers:
+    sets of output buffers that frames take in turn (the module's notes): 1, or 2 so that a
+    frame's output stays valid while the next frame computes.
     """
 
     def __init__(self, scene: Scene, device=None, request: Request | None = None,
-                 tessellator: Tessellator | None = None, **options):
+                 tessellator: Tessellator | None = None, buffers: int = 1, **options):
+        if isinstance(buffers, bool) or not isinstance(buffers, int) or buffers < 1:
+            raise ValueError(f"buffers must be a whole number >= 1, got {buffers!r}")
         self.tessellator = tessellator if tessellator is not None else Tessellator(device)
         self.scene = scene
         self.request = request if request is not None else Request.of(**options)
         self.request.check(scene)
-        self.output = OutputBuffers(self.tessellator, pinned=True)
+        self._sets = [FrameBuffers(OutputBuffers(self.tessellator, pinned=True)) for _ in range(buffers)]
+        self._current = self._sets[0]  # the set of the latest frame (the next frame's before the first)
         self._scene_data: dict = {}  # sharp_edges -> SceneData
-        self._scratch: dict = {}  # sharp_edges -> the per-patch arrays of stages 1-3
         self.frames = 0
         self._plans: list = []  # the last two frames' plans: their totals grow the buffers for the next
         self._composed = None  # the (work, stage 3 choices) of the last frame composed for the session's request
-        self._recorded = None  # the last frame made for the session's request, to replay (RecordedFrame)
+
+    @property
+    def output(self) -> OutputBuffers:
+        """The output buffers of the latest frame (before any frame: the first frame's)."""
+        return self._current.output
+
+    @property
+    def _recorded(self) -> RecordedFrame | None:
+        """The recorded frame of the latest frame's buffer set."""
+        return self._current.recorded
 
     @property
     def device(self):
@@ -102,7 +134,8 @@ class Session:
                    **request_overrides) -> Tessellation:
         """One frame: stages 1-5 for the whole scene with this camera (pixel tolerance) and
         these changes to the session's request (``request_for``).  The output stays on the
-        device (``.device``); host arrays on first use, valid until the next call.
+        device (``.device``); host arrays on first use, valid until the next call (with
+        ``buffers=2``, the call after next).
 
         host=True: the frame is for host arrays (``frame.positions`` and the rest, as
         ``fetch()``): their read-back is enqueued right behind the stages (on a CPU device the
@@ -134,7 +167,7 @@ class Session:
         key = request.sharp_edges
         if key not in self._scene_data:
             self._scene_data[key] = tessellator.scene_data(self.scene, key)
-            self._scratch[key] = {}
+        self._current = buffers = self._sets[self.frames % len(self._sets)]
         # The frame before last is settled (its totals are read: a wait only if the device is two
         # frames behind, so no more than two frames are ever in flight), the last one if its
         # totals are there; the buffers then hold at least what those needed.
@@ -143,8 +176,8 @@ class Session:
                 plan.settle()
             elif plan.totals_ready():  # (its copy is complete: no wait call)
                 plan.settle(ready=True)
-            if plan.settled:
-                self.output.reserve(plan.num_vertices, plan.num_indices // 3)
+            if plan.settled:  # (this frame's set only: the other sets' frames may still be in use)
+                buffers.output.reserve(plan.num_vertices, plan.num_indices // 3)
         settled = [plan for plan in self._plans if plan.settled]
         if settled:  # work="auto" chooses by the latest settled frame (Tessellator.auto_work)
             tessellator.note_plan(settled[-1])
@@ -152,18 +185,18 @@ class Session:
         # with the same ones only enqueue (programs.Kernel).  A new camera alone replays the last
         # frame recorded for these settings and buffers (recorded.py); any other frame is made
         # the normal way, and recorded if it was made for the session's request.
-        programs, data, scratch = tessellator.programs, self._scene_data[key], self._scratch[key]
-        recorded = self._recorded
+        programs, data = tessellator.programs, self._scene_data[key]
+        scratch, recorded = buffers.scratch.setdefault(key, {}), buffers.recorded
         programs.keep_arguments = True
         try:
             if not request_overrides and recorded is not None and recorded.key == self._frame_key():
-                pending = recorded.replay(tessellator, data, request, started, scratch, self.output)
+                pending = recorded.replay(tessellator, data, request, started, scratch, buffers.output)
             else:
                 programs.recording = [] if not request_overrides else None
                 plan = tessellator.plan_on(data, request, started, scratch, defer_totals=True)
-                pending = tessellator.emit_async(plan, 0, plan.num_patches, out=self.output)
+                pending = tessellator.emit_async(plan, 0, plan.num_patches, out=buffers.output)
                 if not request_overrides:
-                    self._recorded = RecordedFrame.of(self._frame_key(), data, pending, programs.recording,
+                    buffers.recorded = RecordedFrame.of(self._frame_key(), data, pending, programs.recording,
                                                       scratch.get("summary"))
         finally:
             programs.keep_arguments = False
@@ -188,7 +221,7 @@ class Session:
 
     def __repr__(self) -> str:
         return (f"Session({self.scene.name!r}, {self.device.name.strip()!r}, {self.frames} frames, "
-                f"output buffers {self.output.nbytes} bytes)")
+                f"output buffers {sum(s.output.nbytes for s in self._sets)} bytes)")
 
 
 __all__ = ["Session"]

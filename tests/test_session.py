@@ -112,6 +112,44 @@ def test_one_shot_results_start_their_read_back_with_their_stages(tessellator, t
     assert_same_output(resident.fetch(), tess)
 
 
+def test_two_buffer_sets_keep_a_frame_while_the_next_one_computes(tessellator, tea_table, monkeypatch):
+    """Session(buffers=2): frames take two sets of buffers in turn, so frame k's output stays
+    valid while frame k+1 is enqueued and computed (the host reads k meanwhile), and goes stale
+    at frame k+2.  Every frame is bitwise the one-shot result: where the output grows (a frame
+    launched on too small buffers runs again on its own set, grown) and for replayed frames
+    (each set records and replays its own launches)."""
+    from cltess.backends.opencl import recorded
+
+    replays = []
+    real_replay = recorded.RecordedFrame.replay
+    monkeypatch.setattr(recorded.RecordedFrame, "replay",
+                        lambda self, *args: replays.append(self) or real_replay(self, *args))
+    session = cltess.Session(tea_table, tessellator=tessellator, pixels=0.5, buffers=2)
+    near = list(orbit(tea_table, 4))  # nearer each time: the output grows
+    cameras = near[:1] * 2 + near[3:] * 2 + near  # a jump that outgrows a set's buffers; then replays
+    frames, fits = [], []
+    for k, camera in enumerate(cameras):
+        frames.append(session.tessellate(camera=camera, host=True, wait=False))
+        if k >= 1:  # the previous frame, read while this one is in flight on the other set
+            previous = frames[k - 1]
+            assert_same_output(previous, tessellator.tessellate(tea_table, request=session.request_for(cameras[k - 1])))
+            fits.append(previous.stats.get("output_fit", True))
+        if k >= 2:  # the one before that shared this frame's set: stale now
+            with pytest.raises(StaleOutput):
+                frames[k - 2].device.positions
+    assert_same_output(frames[-1], tessellator.tessellate(tea_table, request=session.request_for(cameras[-1])))
+    assert False in fits  # (a frame run again on grown buffers is covered)
+    assert {id(s.recorded) for s in session._sets} == {id(r) for r in replays[-2:]}  # each set its own
+    assert len(replays) >= 2 and session.frames == len(cameras)
+    assert session._sets[0].output is not session._sets[1].output
+
+
+@pytest.mark.parametrize("buffers", [0, -1, 1.5, True, "2"])
+def test_session_refuses_a_count_of_buffer_sets_that_is_not_a_whole_number(tessellator, tea_table, buffers):
+    with pytest.raises(ValueError, match="buffers must be"):
+        cltess.Session(tea_table, tessellator=tessellator, pixels=0.5, buffers=buffers)
+
+
 def test_session_overrides_and_growing_buffers(tessellator, tea_table):
     session = cltess.Session(tea_table, tessellator=tessellator, eps=0.02)
     coarse = session.tessellate()
