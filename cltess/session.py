@@ -88,6 +88,7 @@ class Session:
         self.frames = 0
         self._plans: list = []  # the last two frames' plans: their totals grow the buffers for the next
         self._composed = None  # the (work, stage 3 choices) of the last frame composed for the session's request
+        self._unread = None  # (pending, frame): the last host frame whose copies wait for its totals (_start_unread)
 
     @property
     def output(self) -> OutputBuffers:
@@ -178,6 +179,8 @@ class Session:
                 plan.settle(ready=True)
             if plan.settled:  # (this frame's set only: the other sets' frames may still be in use)
                 buffers.output.reserve(plan.num_vertices, plan.num_indices // 3)
+        if self._unread is not None:
+            self._start_unread()
         settled = [plan for plan in self._plans if plan.settled]
         if settled:  # work="auto" chooses by the latest settled frame (Tessellator.auto_work)
             tessellator.note_plan(settled[-1])
@@ -203,10 +206,26 @@ class Session:
             programs.recording = None
         self._plans = [*self._plans[-1:], pending.plan]
         self.frames += 1
-        if host:  # (a GPU's copies need the totals: there fetch enqueues them, after the stages)
-            pending.start_read_back()
+        started = pending.start_read_back() if host else True  # (a GPU's copies need the totals)
         frame = pending.result(on_device=True, wait=wait)
+        if not started and not wait and len(self._sets) > 1:  # the next call enqueues them (_start_unread)
+            self._unread = (pending, frame)
         return frame.fetch() if host and wait else frame
+
+    def _start_unread(self) -> None:
+        """The read-back of the last frame, asked for host arrays with ``wait=False`` on a device
+        whose copies need the frame's totals (a GPU): enqueued now, before this frame's stages,
+        once those totals are read (they are, unless its stage 3 is still running: then a short
+        wait), so that its ``fetch()`` waits for its own copies alone and not for this frame's
+        stages behind them on the in-order queue.  Only with two buffer sets, where that frame
+        stays valid through this one; not for a frame already fetched or stale."""
+        pending, frame = self._unread
+        self._unread = None
+        device = frame.device
+        if frame.on_host or device is None or not device.valid():
+            return
+        device.settle()  # its totals; its stages 4-5 again where its output did not fit
+        pending.start_read_back((device.num_vertices, device.num_triangles))
 
     def _frame_key(self) -> tuple:
         """What a frame's launches depend on besides its camera: the tessellator's settings

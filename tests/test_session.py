@@ -144,6 +144,41 @@ def test_two_buffer_sets_keep_a_frame_while_the_next_one_computes(tessellator, t
     assert session._sets[0].output is not session._sets[1].output
 
 
+def test_two_buffer_sets_copy_a_frame_before_the_next_frames_stages(tessellator, tea_table, monkeypatch):
+    """Where a frame's read-back is a copy that needs its totals (a GPU: forced here on any
+    device), a frame asked for host arrays with wait=False has its copies enqueued by the next
+    call at the latest, before that frame's stages 4-5, so that its fetch finds them started
+    (no copy of its own, and no wait behind the next frame's stages); bitwise the one-shot
+    result, also where it did not fit its buffers and ran again."""
+    from cltess.backends.opencl import output
+
+    session = cltess.Session(tea_table, tessellator=tessellator, pixels=0.5, buffers=2)
+    for buffers in session._sets:  # copies through page-locked buffers, as on a GPU
+        buffers.output.mapped, buffers.output.pinned = False, True
+    events = []  # ("take", set): a frame's stages 4-5 are enqueued right after; ("copy", set)
+    real_copies, real_take = output.OutputBuffers._enqueue_copies, output.OutputBuffers.take
+    monkeypatch.setattr(output.OutputBuffers, "_enqueue_copies",
+                        lambda self, *sizes: events.append(("copy", self)) or real_copies(self, *sizes))
+    monkeypatch.setattr(output.OutputBuffers, "take",
+                        lambda self, *sizes: events.append(("take", self)) or real_take(self, *sizes))
+    near = list(orbit(tea_table, 4))
+    cameras = near[:1] * 2 + near[3:] * 2 + near  # a jump that outgrows a set's buffers; then replays
+    frames, starts, fits = [], [], []
+    for k, camera in enumerate(cameras):
+        starts.append(len(events))
+        frames.append(session.tessellate(camera=camera, host=True, wait=False))
+        if k >= 1:
+            mine, theirs = session._sets[(k - 1) % 2].output, session._sets[k % 2].output
+            last_take = max(i for i, event in enumerate(events) if event == ("take", theirs))
+            assert ("copy", mine) in events[starts[k - 1]:last_take]  # frame k-1's, before frame k's stages
+            before = len(events)
+            assert_same_output(frames[k - 1], tessellator.tessellate(tea_table,
+                                                                     request=session.request_for(cameras[k - 1])))
+            assert ("copy", mine) not in events[before:]  # its fetch found them started
+            fits.append(frames[k - 1].stats.get("output_fit", True))
+    assert False in fits  # (a frame run again on grown buffers is covered)
+
+
 @pytest.mark.parametrize("buffers", [0, -1, 1.5, True, "2"])
 def test_session_refuses_a_count_of_buffer_sets_that_is_not_a_whole_number(tessellator, tea_table, buffers):
     with pytest.raises(ValueError, match="buffers must be"):

@@ -1060,8 +1060,8 @@ class _Ready:
 
     tessellation: Tessellation
 
-    def start_read_back(self) -> None:  # (read back already)
-        pass
+    def start_read_back(self, sizes: tuple | None = None) -> bool:  # (read back already)
+        return True
 
     def result(self, on_device: bool = False, wait: bool = True) -> Tessellation:
         return self.tessellation
@@ -1083,21 +1083,24 @@ class PendingEmit:
     strips: np.ndarray | None = None  # host strips of a strip pattern (cltess.strips)
     forward_differencing: bool | None = None  # as asked of emit_async (a run again asks the same)
 
-    def start_read_back(self) -> None:
+    def start_read_back(self, sizes: tuple | None = None) -> bool:
         """Enqueue the host read-back (and the factors' copy) now, right behind these stages,
         so that ``result()`` only waits for it: what the host enqueues meanwhile (the next
         batch's stages: cltess.stream) then runs while the host reads this output, and the
         read-back costs no round trip of its own.  A CPU device's map needs no sizes, so it is
         started also for a Session frame whose totals are still on their way; a GPU's copies
-        need them: there only for a settled plan."""
+        need them: there only for a settled plan, or with ``sizes`` (vertices, triangles) of
+        the output as settled (``DeviceOutput.num_vertices``, ``num_triangles``: a Session
+        frame once its totals are read).  Returns whether it was started."""
         if self.buffers.mapped:
             sizes = ()
-        elif self.plan.settled:
+        elif sizes is None:
+            if not self.plan.settled:
+                return False
             sizes = (self.arrays.num_vertices, self.arrays.num_triangles)
-        else:
-            return
         self.plan.enqueue_host_factors()
         self.buffers.start_read_back(*sizes)
+        return True
 
     def result(self, on_device: bool = False, wait: bool = True) -> Tessellation:
         """The Tessellation.  wait=False (with on_device): return at once, the stages still
