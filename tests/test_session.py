@@ -179,6 +179,23 @@ def test_two_buffer_sets_copy_a_frame_before_the_next_frames_stages(tessellator,
     assert False in fits  # (a frame run again on grown buffers is covered)
 
 
+def test_two_buffer_sets_with_overrides_grow_only_the_set_a_frame_takes(tessellator, tea_table):
+    """Frames made the normal way (request overrides) take the sets in turn too: a finer frame
+    grows its own set and leaves the previous frame's valid; the frame after takes that one."""
+    session = cltess.Session(tea_table, tessellator=tessellator, eps=0.02, buffers=2)
+    coarse = session.tessellate()
+    coarse_size = session._sets[0].output.nbytes
+    fine = session.tessellate(eps=0.002)  # set 1, more output
+    assert session._sets[0].output.nbytes == coarse_size < session._sets[1].output.nbytes
+    assert_same_output(coarse, tessellator.tessellate(tea_table, eps=0.02))  # still valid
+    assert_same_output(fine, tessellator.tessellate(tea_table, eps=0.002))
+    again = session.tessellate(eps=0.002)  # set 0 again: grows, and the coarse frame is stale
+    assert session._sets[0].output.nbytes > coarse_size
+    with pytest.raises(StaleOutput):  # (its host arrays, fetched above, are views the new frame overwrote)
+        coarse.device.positions
+    assert_same_output(again, tessellator.tessellate(tea_table, eps=0.002))
+
+
 @pytest.mark.parametrize("buffers", [0, -1, 1.5, True, "2"])
 def test_session_refuses_a_count_of_buffer_sets_that_is_not_a_whole_number(tessellator, tea_table, buffers):
     with pytest.raises(ValueError, match="buffers must be"):
