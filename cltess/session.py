@@ -225,7 +225,8 @@ class Session:
         if frame.on_host or device is None or not device.valid():
             return
         device.settle()  # its totals; its stages 4-5 again where its output did not fit
-        pending.start_read_back((device.num_vertices, device.num_triangles))
+        arrays = device.arrays  # (as settled: the sizes its fetch reads back, 0 included)
+        pending.start_read_back((arrays.num_vertices, arrays.num_triangles))
 
     def _frame_key(self) -> tuple:
         """What a frame's launches depend on besides its camera: the tessellator's settings

@@ -1090,8 +1090,8 @@ class PendingEmit:
         read-back costs no round trip of its own.  A CPU device's map needs no sizes, so it is
         started also for a Session frame whose totals are still on their way; a GPU's copies
         need them: there only for a settled plan, or with ``sizes`` (vertices, triangles) of
-        the output as settled (``DeviceOutput.num_vertices``, ``num_triangles``: a Session
-        frame once its totals are read).  Returns whether it was started."""
+        the output as settled (a Session frame once its totals are read: its DeviceOutput's
+        arrays).  Returns whether it was started."""
         if self.buffers.mapped:
             sizes = ()
         elif sizes is None:
