@@ -206,9 +206,9 @@ class Session:
             programs.recording = None
         self._plans = [*self._plans[-1:], pending.plan]
         self.frames += 1
-        started = pending.start_read_back() if host else True  # (a GPU's copies need the totals)
+        reading = pending.start_read_back() if host else True  # (a GPU's copies need the totals)
         frame = pending.result(on_device=True, wait=wait)
-        if not started and not wait and len(self._sets) > 1:  # the next call enqueues them (_start_unread)
+        if not reading and not wait and len(self._sets) > 1:  # the next call enqueues them (_start_unread)
             self._unread = (pending, frame)
         return frame.fetch() if host and wait else frame
 
