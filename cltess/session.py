@@ -10,6 +10,8 @@ What a ``Session`` keeps between calls, so that a frame costs only the five stag
 * the scene's device data (``Tessellator.scene_data``): every kind's upload, the object ids,
   stage 2's edge groups (the host adjacency behind them is cached on the scene);
 * the per-patch arrays of stages 1-3 (factors, flags, counts, offsets: sized by the scene);
+* for the "*-prep" work distributions (GPUs), the patches prepared for stage 4 (each kind_patch,
+  made once from a kind's upload where no frame rewrites it: Bézier patches);
 * the output buffers (``OutputBuffers``), grown only when a frame needs more, and on a GPU the
   page-locked host buffers its read-back goes through.
 
@@ -168,6 +170,9 @@ class Session:
         key = request.sharp_edges
         if key not in self._scene_data:
             self._scene_data[key] = tessellator.scene_data(self.scene, key)
+            for kind, _, count, uploaded in self._scene_data[key].parts:
+                if kind.controls_shape(count) is None:  # stage 4 reads the upload, which no frame rewrites:
+                    uploaded["prepared"] = {}  # "*-prep" prepares its patches once (Tessellator._prepared_points)
         self._current = buffers = self._sets[self.frames % len(self._sets)]
         # The frame before last is settled (its totals are read: a wait only if the device is two
         # frames behind, so no more than two frames are ever in flight), the last one if its

@@ -497,8 +497,11 @@ POINTS.update(PREPARED_POINTS)
 POINTS.update(PREPARED_ROWS)
 #: Session frames (cltess.Session) whose second frame does not fit the first one's buffers:
 #: stages 4-5 launched on the buffers' capacity write nothing (batch_fits, kernels/common.h),
-#: then run again on grown buffers (issue 15, docs/design.md section 11); per patch and per point.
-FRAMES = {"many_patches_frames": ("many_patches", "patch"), "many_patches_frames_by_points": ("many_patches", "point")}
+#: then run again on grown buffers (issue 15, docs/design.md section 11); per patch, per point,
+#: and by rows of patches the session prepared once (every Bézier patch, culled ones too:
+#: prepare_patches' `every`; the PN part prepared per frame).
+FRAMES = {"many_patches_frames": ("many_patches", "patch"), "many_patches_frames_by_points": ("many_patches", "point"),
+          "mixed_culled_frames_by_prepared_rows": ("mixed_culled", "rows-prep")}
 #: Scenarios whose stage 3 is one launch per range (Tessellator.fused_offsets: stages/offsets.cl),
 #: with work-groups of FUSED_OFFSETS_GROUP_HERE patches so that a range takes several tiles: two
 #: kinds (two ranges, the second from the first's total), culled patches, more patches than a tile.

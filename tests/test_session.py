@@ -196,6 +196,28 @@ def test_two_buffer_sets_with_overrides_grow_only_the_set_a_frame_takes(tessella
     assert_same_output(again, tessellator.tessellate(tea_table, eps=0.002))
 
 
+@pytest.mark.parametrize("work", ["rows-prep", "point-prep"])
+def test_a_session_prepares_its_patches_once(tessellator, tea_table, monkeypatch, work):
+    """A Session's "*-prep" frames prepare the scene's Bézier patches once, every patch (the
+    first frame's set-up, not replayed), and later frames read them: bitwise the per-patch
+    kernels' frames, also where a patch culled in one frame is seen in the next."""
+    from cltess.backends.opencl import programs, tessellator as opencl
+
+    launched = []
+    real_launch = programs.Kernel.launch
+    monkeypatch.setattr(programs.Kernel, "launch", lambda self, *args, **kwargs:
+                        launched.append(self.kernel.function_name) or real_launch(self, *args, **kwargs))
+    prepared = opencl.Tessellator(tessellator.device, work=work)
+    session = cltess.Session(tea_table, tessellator=prepared, pixels=0.5)
+    culled = []
+    for camera in list(orbit(tea_table, 4))[::-1] * 2:  # nearest first: the most culled; then replays
+        frame = session.tessellate(camera=camera)
+        assert_same_output(frame, tessellator.tessellate(tea_table, request=session.request_for(camera)))
+        culled.append(frame.stats["culled"])
+    assert culled[0] > min(culled)  # (patches culled in the first frame are seen in later ones)
+    assert launched.count("prepare_patches") == 1
+
+
 @pytest.mark.parametrize("buffers", [0, -1, 1.5, True, "2"])
 def test_session_refuses_a_count_of_buffer_sets_that_is_not_a_whole_number(tessellator, tea_table, buffers):
     with pytest.raises(ValueError, match="buffers must be"):

@@ -7,7 +7,9 @@
  *   prepare_patches   a work-item per patch of the batch: kind_load, and the kind_patch stored
  *                     to prepared[p - first_patch], float4 by float4 with its unused lanes (a
  *                     float3's fourth) zeroed, so no undefined byte is stored (Oclgrind's
- *                     uninitialised-value pass); a patch without vertices is skipped;
+ *                     uninitialised-value pass); a patch without vertices is skipped, unless
+ *                     `every` (a Session keeps a scene's prepared patches for all its frames:
+ *                     a patch culled now may have vertices in a later frame);
  *   prepared_points   as vertex_points, the patch copied from prepared[] (no arithmetic; the
  *                     lanes of a warp mostly read the same patch: cached) instead of kind_load;
  *   kind_patch_size   sizeof(kind_patch), for the host's scratch buffer.
@@ -25,10 +27,11 @@ __kernel void kind_patch_size(__global uint *size)
 
 __kernel void prepare_patches(__global const float4 *controls, __global const ulong *vertex_offsets,
                               uint first_patch, uint num_patches, uint patch_base,
-                              __global float4 *prepared)  /* kind_patch records, written word by word */
+                              __global float4 *prepared,  /* kind_patch records, written word by word */
+                              int every)
 {
     uint slot = (uint)get_global_id(0), p = first_patch + slot;
-    if (slot >= num_patches || vertex_offsets[p + 1] == vertex_offsets[p])
+    if (slot >= num_patches || (!every && vertex_offsets[p + 1] == vertex_offsets[p]))
         return;  /* past the batch, or no vertex (culled, folded): never read */
     union {
         kind_patch patch;

@@ -20,7 +20,8 @@ from .events import wait_ms
 @dataclass
 class PlanPart:
     """One kind's patches in a plan: scene numbers ``base .. base + count - 1``, tessellated
-    with ``pattern``; data: its device arrays ("source", "controls")."""
+    with ``pattern``; data: its device arrays ("source", "controls"; for a Session's scene,
+    "prepared": the patches prepared for stage 4, kept across frames: Tessellator._prepared_points)."""
 
     kind: PatchKind
     pattern: Pattern

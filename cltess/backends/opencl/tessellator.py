@@ -632,7 +632,7 @@ class Tessellator:
             events["vertices"] += self.stage_vertices(
                 part.data["controls"], plan.factors, plan.vertex_offsets, plan.objects, vertex_range,
                 (lo, hi), forward_differencing, kind=part.kind, patch_base=part.base, out=vertices,
-                pattern=part.pattern, work=work)[1]
+                pattern=part.pattern, work=work, kept_prepared=part.data.get("prepared"))[1]
             events["indices"] += self.stage_indices(
                 plan.factors, plan.vertex_offsets, plan.index_offsets, index_range, (lo, hi),
                 kind=part.pattern, out=arrays.raw("triangles"), work=work)[1]
@@ -923,7 +923,8 @@ class Tessellator:
 
     def stage_vertices(self, controls, factors, vertex_offsets, patch_objects, vertex_range,
                        patch_range, forward_differencing=True, kind=BEZIER, patch_base=0, out=None,
-                       pattern=None, rows_per_patch: int | None = None, work: str | None = None):
+                       pattern=None, rows_per_patch: int | None = None, work: str | None = None,
+                       kept_prepared: dict | None = None):
         """Stage 4 for patches patch_range = (first, last) (scene numbers, all of one kind whose
         first patch is patch_base; controls: that kind's stage-4 input, Bézier patches or PN
         control points), whose vertices are vertex_range = (start, stop) -> dict of positions
@@ -936,7 +937,8 @@ class Tessellator:
         None: as ``work``).  work: "patch", "rows" (with ``MAX_ROWS_PER_PATCH``), "vertex" or
         "point" (stages/vertex_points.cl, a work-item per vertex), "vertex-prep" or "point-prep"
         (stages/prepared_points.cl: the patches prepared first), "rows-prep" (the same, a
-        work-item per row or ring edge); None: the Tessellator's ``work``."""
+        work-item per row or ring edge); None: the Tessellator's ``work``.  kept_prepared: where a
+        "*-prep" distribution keeps the patches it prepares, across calls (``_prepared_points``)."""
         out = self._vertex_arrays(vertex_range[1] - vertex_range[0]) if out is None else out
         first, last = patch_range
         if vertex_range[1] == vertex_range[0] or last <= first:
@@ -953,7 +955,7 @@ class Tessellator:
             rows_per_patch = MAX_ROWS_PER_PATCH
         if rows_per_patch is None and work in PREPARED_WORK:
             event = self._prepared_points(controls, factors, vertex_offsets, patch_objects, vertex_range, first, last,
-                                          forward_differencing, kind, patch_base, pattern, out, work)
+                                          forward_differencing, kind, patch_base, pattern, out, work, kept_prepared)
         elif rows_per_patch is None and work in ("vertex", "point"):  # work-items past the part's vertices return
             event = self.programs.kernel("vertex_points", kind=kind, pattern=pattern)(
                 self.queue, _record_groups(vertex_range[1] - vertex_range[0], self.records_for(work)), (WORK_GROUP,),
@@ -972,7 +974,10 @@ class Tessellator:
         kind_patch (its size as the device compiler lays it out: kernel kind_patch_size), grown
         when needed.  Tessellator.compose makes it for the scene before the plan's buffers:
         Oclgrind's uninitialised-value plugin took a buffer made after them for never written
-        (every prepared_points read reported; made first, the same run is clean)."""
+        (every prepared_points read reported; made first, the same run is clean).  So too a
+        buffer made where one just freed had been: the size's answer array lives until the
+        buffer is made (with it freed first, as a helper returning the size did, every
+        prepared_rows read of mixed_culled_by_prepared_rows was reported)."""
         size = self._kind_patch_sizes.get((kind.name, pattern.header))
         if size is None:
             answer = cl_array.empty(self.queue, 1, np.uint32)
@@ -984,36 +989,67 @@ class Tessellator:
             self._prepared = cl.Buffer(self.context, cl.mem_flags.READ_WRITE, needed + needed // 4)
         return self._prepared
 
+    def kind_patch_size(self, kind, pattern) -> int:
+        """Bytes of ``kind``'s kind_patch as the device compiler lays it out (``prepared_scratch``
+        finds it, and compose calls that for every "*-prep" scene)."""
+        if (kind.name, pattern.header) not in self._kind_patch_sizes:
+            self.prepared_scratch(kind, pattern, 1)
+        return self._kind_patch_sizes[kind.name, pattern.header]
+
     def _prepared_points(self, controls, factors, vertex_offsets, patch_objects, vertex_range, first, last,
-                         forward_differencing, kind, patch_base, pattern, out, work="point-prep") -> tuple:
+                         forward_differencing, kind, patch_base, pattern, out, work="point-prep",
+                         kept: dict | None = None) -> tuple:
         """Stage 4 from prepared patches (stages/prepared_points.cl): prepare_patches writes
         patches first .. last-1's kind_patch to a scratch buffer (kept, grown as needed; the
         queue is in order, so a later batch's prepare waits for this batch's reads), then
         prepared_points (a work-item per vertex) or, for work="rows-prep", prepared_rows (a
         work-group per ``patches_per_group`` patches, a work-item per line) writes the vertices.
-        Returns both events (the profiling span of stage 4 runs from the first to the last)."""
+        Returns both events (the profiling span of stage 4 runs from the first to the last).
+
+        kept: a dict the caller keeps with the scene's device data (a Session's, for a kind whose
+        stage-4 input is its upload, which no frame rewrites): the patches are prepared there
+        once, every one of them (a patch culled in this frame may be seen in the next), and
+        later calls read them without preparing again.  That preparation is the scene's set-up,
+        as its upload is: not recorded for a replayed frame, and not among the returned events
+        (stage 4 is then the vertices' kernel alone)."""
         program = dict(kind=kind, pattern=pattern)
-        self.prepared_scratch(kind, pattern, last - first)
-        prepare = self.programs.kernel("prepared_points", "prepare_patches", **program)(
-            self.queue, _global_size(last - first), None, controls.data, vertex_offsets.data, np.uint32(first),
-            np.uint32(last - first), np.uint32(patch_base), self._prepared)
+
+        def prepare(into, every: int):
+            return self.programs.kernel("prepared_points", "prepare_patches", **program)(
+                self.queue, _global_size(last - first), None, controls.data, vertex_offsets.data, np.uint32(first),
+                np.uint32(last - first), np.uint32(patch_base), into, np.int32(every))
+
+        if kept is None:  # this call's patches that have vertices, into the scratch buffer
+            prepared = self.prepared_scratch(kind, pattern, last - first)
+            events = (prepare(prepared, every=0),)
+        else:
+            key, events = (pattern.header, first, last, patch_base), ()
+            prepared = kept.get(key)
+            if prepared is None:  # the first call: every patch, into a buffer of the caller's
+                size = max(1, last - first) * self.kind_patch_size(kind, pattern)
+                prepared = kept[key] = cl.Buffer(self.context, cl.mem_flags.READ_WRITE, size)
+                recording, self.programs.recording = self.programs.recording, None  # (set-up: not replayed)
+                try:
+                    prepare(prepared, every=1)
+                finally:
+                    self.programs.recording = recording
         if work == "rows-prep":
             per_group = self.line_patches_for(last - first)
             if not 0 < per_group <= LINE_MAX_PATCHES:
                 raise ValueError(f"patches_per_group={per_group}: expected 1 .. {LINE_MAX_PATCHES}")
             rows = self.programs.kernel("prepared_points", "prepared_rows", **program)(
                 self.queue, (-(-(last - first) // per_group) * LINE_GROUP,), (LINE_GROUP,),
-                self._prepared, factors.data, vertex_offsets.data, patch_objects.data, np.uint32(first),
+                prepared, factors.data, vertex_offsets.data, patch_objects.data, np.uint32(first),
                 np.uint32(last - first), np.uint64(vertex_range[0]), np.int32(forward_differencing),
                 np.uint64(vertex_range[1] - vertex_range[0]), np.uint32(per_group), *(a.data for a in out.values()))
-            return prepare, rows
+            return (*events, rows)
         per_item = self.records_for("point-prep")
         points = self.programs.kernel("prepared_points", **program)(
             self.queue, _record_groups(vertex_range[1] - vertex_range[0], per_item), (WORK_GROUP,),
-            self._prepared, factors.data, vertex_offsets.data, patch_objects.data, np.uint32(first),
+            prepared, factors.data, vertex_offsets.data, patch_objects.data, np.uint32(first),
             np.uint32(last - first), np.uint64(vertex_range[0]), np.int32(forward_differencing),
             np.uint64(vertex_range[1] - vertex_range[0]), np.uint32(per_item), *(a.data for a in out.values()))
-        return prepare, points
+        return (*events, points)
 
     def stage_indices(self, factors, vertex_offsets, index_offsets, index_range, patch_range,
                       kind=BEZIER, out=None, work: str | None = None):
