@@ -6,6 +6,10 @@ Per-frame criteria: ``--silhouette [M]`` (silhouette refinement with blended lev
 Reimers and Seland 2008: ``cltess.backends.opencl.silhouette``; every edge keeps at least the
 ``--eps`` error bound's level unless ``--no-bound``) or ``--pixels`` (the screen-space tolerance of each frame's
 camera).  The camera-path file format is ``cltess.io.camera_path``.
+
+``--pixels`` frames come from a ``cltess.Session`` with two buffer sets: the scene's device data
+made once, and frame k+1 computed while frame k is written (its arrays stay valid until the
+session's second call after it).
 """
 from __future__ import annotations
 
@@ -105,18 +109,17 @@ def run_frames(args, scene, cameras, tessellator, weld: bool, say) -> list[dict]
                                     blend=not args.no_blend, snap=not args.no_snap, centre=args.centre or "pn",
                                     **mesh_options)
         say(f"prepared once: {refiner.prepare_ms:.1f} ms (stages 1-3, edge data)")
-        produce = lambda camera: refiner.frame(camera)  # noqa: E731
+        results = (refiner.frame(camera) for camera in cameras)
     else:
         from .criteria.tolerance import ScreenSpace
         from .request import Request
+        from .session import Session
 
-        def produce(camera):
-            request = Request(ScreenSpace(args.pixels, camera), max_factor=args.max_factor,
-                              forward_differencing=not args.no_fd, pattern=args.pattern_name,
-                              max_level=args.max_level, **mesh_options)
-            return tessellator.tessellate(scene, request)
-    for index, camera in enumerate(cameras):
-        result = produce(camera)
+        request = Request(ScreenSpace(args.pixels, cameras[0]), max_factor=args.max_factor,
+                          forward_differencing=not args.no_fd, pattern=args.pattern_name,
+                          max_level=args.max_level, **mesh_options)
+        results = _pipelined(Session(scene, tessellator=tessellator, request=request, buffers=2), cameras)
+    for index, (camera, result) in enumerate(zip(cameras, results)):
         tess, lod = (result.tessellation, result.lod) if hasattr(result, "tessellation") else (result, None)
         stats = dict(tess.stats)
         if what == "meshes":
@@ -133,6 +136,18 @@ def run_frames(args, scene, cameras, tessellator, weld: bool, say) -> list[dict]
         with atomic_write(args.output, "w") as handle:
             json.dump({"frames": summaries}, handle, indent=1)
     return summaries
+
+
+def _pipelined(session, cameras):
+    """Each camera's frame with its host arrays, frame k+1 enqueued before frame k is given (two
+    buffer sets: frame k stays valid until the session's second call after it, by when the
+    caller has written it)."""
+    frame = session.tessellate(camera=cameras[0], host=True, wait=False)
+    for following in cameras[1:]:
+        after = session.tessellate(camera=following, host=True, wait=False)
+        yield frame.fetch()
+        frame = after
+    yield frame.fetch()
 
 
 def parse_phi(text: str) -> float:

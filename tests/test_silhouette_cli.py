@@ -55,6 +55,25 @@ def test_pixels_per_frame(files):
     assert all((files / f"px_{k}.ply").exists() for k in range(3))
 
 
+def test_pixel_frames_are_each_cameras_one_shot_tessellation(files):
+    """--pixels frames come from a two-set Session, frame k+1 computed while frame k is written:
+    each is bitwise the one-shot tessellation for its camera."""
+    from cltess.criteria.tolerance import ScreenSpace
+    from cltess.io.camera_path import read_camera_path
+    from cltess.pipeline import Tessellator
+    from cltess.request import Request
+
+    out = files / "bits_{frame}.npz"
+    assert main(["tessellate", str(files / "sphere.ply"), "--pixels", "2", "--camera-path",
+                 str(files / "orbit.json"), "-o", str(out), "--no-weld", "-q"]) == 0
+    scene, tessellator = load_scene(files / "sphere.ply"), Tessellator()
+    for k, camera in enumerate(read_camera_path(files / "orbit.json")):
+        expected = tessellator.tessellate(scene, Request(ScreenSpace(2.0, camera)))
+        got = load_npz(files / f"bits_{k}.npz")
+        for field in ("positions", "normals", "uv", "patch_ids", "object_ids", "triangles"):
+            assert np.array_equal(getattr(got, field), getattr(expected, field)), (k, field)
+
+
 @pytest.mark.parametrize("argv, message", [
     (["--eps", "1%", "--camera-path", "{orbit}", "-o", "{dir}/a_{{frame}}.ply"], "needs a per-frame criterion"),
     (["--eps", "1%", "--silhouette", "--camera-path", "{orbit}", "-o", "{dir}/a.ply"], "need {frame}"),
