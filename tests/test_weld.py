@@ -61,6 +61,32 @@ def test_edge_counts_see_boundary_nonmanifold_and_misoriented_edges():
     assert edge_counts(np.array([[0, 1, 2], [1, 0, 3], [0, 1, 4]]))["nonmanifold_edges"] == 1
 
 
+def edge_counts_by_counting(triangles) -> dict:
+    """edge_counts the obvious way: each undirected edge's uses and their directions, counted."""
+    uses, directions = {}, {}
+    for a, b, c in np.asarray(triangles).tolist():
+        for start, end in ((a, b), (b, c), (c, a)):
+            key = (min(start, end), max(start, end))
+            uses[key] = uses.get(key, 0) + 1
+            directions.setdefault(key, []).append(start < end)
+    return {"boundary_edges": sum(n == 1 for n in uses.values()),
+            "nonmanifold_edges": sum(n > 2 for n in uses.values()),
+            "misoriented_edges": sum(n == 2 and directions[key][0] == directions[key][1] for key, n in uses.items())}
+
+
+def test_edge_counts_equal_counting_on_random_meshes():
+    """Small vertex counts make shared, non-manifold, misoriented and degenerate edges common."""
+    rng = np.random.default_rng(12)
+    for _ in range(500):
+        triangles = rng.integers(0, int(rng.integers(3, 12)), size=(int(rng.integers(1, 40)), 3))
+        assert edge_counts(triangles) == edge_counts_by_counting(triangles)
+    sphere = np.array(trimesh.creation.icosphere(2).faces)  # closed; some faces turned over
+    turned = rng.random(len(sphere)) < 0.05
+    sphere[turned] = sphere[turned][:, ::-1]
+    counts = edge_counts(sphere)
+    assert counts == edge_counts_by_counting(sphere) and counts["boundary_edges"] == 0 < counts["misoriented_edges"]
+
+
 def check_closed(mesh):
     loaded = mesh.to_trimesh()
     assert loaded.is_watertight and loaded.is_winding_consistent
