@@ -137,20 +137,24 @@ def _candidates(points, objects, edges, chunk):
 
     vertex_keys = key(objects, vertex_cells)
     by_cell = np.argsort(vertex_keys).astype(np.int32)
-    vertex_keys = vertex_keys[by_cell]
+    # the occupied cells, each with its run of vertices in by_cell
+    cells, cell_start, cell_count = np.unique(vertex_keys[by_cell], return_index=True, return_counts=True)
     edge_objects = objects[edges[:, 0]]
     box_lo, box_hi = np.minimum(a, b).astype(np.float32), np.maximum(a, b).astype(np.float32)
     points32 = points.astype(np.float32)  # exact: the points are float32 values
     ends = edges.astype(np.int32)
     step = max(1, chunk // 4)
+    reaches = [[span[:, axis] > k for k in range(int(span[:, axis].max()))] for axis in range(3)]
     for offset in np.ndindex(*span.max(axis=0)):
-        covers = np.flatnonzero((np.array(offset) < span).all(axis=1))
+        covers = np.flatnonzero(reaches[0][offset[0]] & reaches[1][offset[1]] & reaches[2][offset[2]])
         for part in range(0, len(covers), step):  # about `chunk` pairs at once
             take = covers[part:part + step]
             e = edge[take]
             keys = key(edge_objects[e], first[take] + np.array(offset))
-            start = np.searchsorted(vertex_keys, keys, "left")
-            n = np.searchsorted(vertex_keys, keys, "right") - start
+            at = np.minimum(np.searchsorted(cells, keys), len(cells) - 1)
+            occupied = cells[at] == keys
+            start = cell_start[at]
+            n = np.where(occupied, cell_count[at], 0)
             e = np.repeat(e, n).astype(np.int32)
             at = np.arange(len(e)) - np.repeat(np.cumsum(n) - n, n)
             vertex = by_cell[np.repeat(start, n) + at]
