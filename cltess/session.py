@@ -169,10 +169,7 @@ class Session:
             self._composed = composed
         key = request.sharp_edges
         if key not in self._scene_data:
-            self._scene_data[key] = tessellator.scene_data(self.scene, key)
-            for kind, _, count, uploaded in self._scene_data[key].parts:
-                if kind.controls_shape(count) is None:  # stage 4 reads the upload, which no frame rewrites:
-                    uploaded["prepared"] = {}  # "*-prep" prepares its patches once (Tessellator._prepared_points)
+            self._scene_data[key] = tessellator.scene_data(self.scene, key, keep_prepared=True)
         self._current = buffers = self._sets[self.frames % len(self._sets)]
         # The frame before last is settled (its totals are read: a wait only if the device is two
         # frames behind, so no more than two frames are ever in flight), the last one if its

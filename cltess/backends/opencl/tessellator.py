@@ -423,16 +423,22 @@ class Tessellator:
         if request.bound == "error-hull":
             self.programs.kernel("error_hull_bound")
 
-    def scene_data(self, scene: Scene, sharp_edges: str = "straight") -> "SceneData":
+    def scene_data(self, scene: Scene, sharp_edges: str = "straight", keep_prepared: bool = False) -> "SceneData":
         """What stays on the device for a scene whatever the tolerance or camera: every kind's
         upload (``upload``), the object ids and the edge groups of stage 2.  The host side
-        (adjacency, welding) is cached on the scene (``Scene.prepared``)."""
+        (adjacency, welding) is cached on the scene (``Scene.prepared``).  keep_prepared (a
+        Session's): a kind whose stage-4 input is its upload, which no frame rewrites (Bézier
+        patches), gets a "prepared" dict in its device arrays, where "*-prep" stage 4 keeps the
+        patches it prepares once for every later call (``_prepared_points``)."""
         kinds = [kind for kind in KINDS if kind.count(scene)]
         parts, inputs, base = [], [], 0
         for kind in kinds:
             count = kind.count(scene)
             host = scene.prepared((kind.name, sharp_edges), lambda: kind.prepare(scene, sharp_edges))
-            parts.append((kind, base, count, self.upload(kind, host.source, scene)))
+            uploaded = self.upload(kind, host.source, scene)
+            if keep_prepared and kind.controls_shape(count) is None:
+                uploaded["prepared"] = {}
+            parts.append((kind, base, count, uploaded))
             inputs.append(host)
             base += count
         objects = cl_array.to_device(self.queue, np.concatenate([host.objects for host in inputs]).astype(np.int32))
@@ -1004,7 +1010,8 @@ class Tessellator:
         queue is in order, so a later batch's prepare waits for this batch's reads), then
         prepared_points (a work-item per vertex) or, for work="rows-prep", prepared_rows (a
         work-group per ``patches_per_group`` patches, a work-item per line) writes the vertices.
-        Returns both events (the profiling span of stage 4 runs from the first to the last).
+        Returns the events: prepare_patches' and the vertices' kernel's (the profiling span of
+        stage 4 runs from the first to the last).
 
         kept: a dict the caller keeps with the scene's device data (a Session's, for a kind whose
         stage-4 input is its upload, which no frame rewrites): the patches are prepared there
