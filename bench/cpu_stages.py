@@ -27,7 +27,9 @@ plan's device buffers, each kernel launched alone ``--repeat`` times:
   this tree and, with ``--baseline-kernels``, from that one (a second Tessellator whose programs
   are built from it), each hashed against the per-patch kernels' output ("same bits");
 * with ``--local-sizes N ...``: this tree's stage 4 and 5 kernels launched with work-group size
-  N too (the engine gives none, so the runtime picks);
+  N too (stages 4 and 5 are otherwise launched as the engine launches them: with 64 on PoCL,
+  programs.py ``names_local_size``, where PoCL's own choice, 4,000 here, overflows its threads'
+  8 MB stacks with the row lanes' private data; elsewhere with none, so the runtime picks);
 * ``--scene KEY``: a scene of the paper's suite (cltess.bench.suite, one kind) at its camera and
   0.5 px instead of uniform level 16; ``--no-probes`` leaves the probes out; ``--rounds N``: N
   interleaved rounds of every launch (the minimum over all of them is reported).
@@ -61,7 +63,8 @@ import frame_loop  # noqa: E402  (teapots, uniform_request, FILL_SOURCE)
 
 from cltess.backends.opencl import Tessellator  # noqa: E402
 from cltess.backends.opencl import programs as programs_module  # noqa: E402
-from cltess.backends.opencl.programs import Programs, composition, correctly_rounded_division, kernel_dir  # noqa: E402
+from cltess.backends.opencl.programs import (Programs, composition, correctly_rounded_division, kernel_dir,  # noqa: E402
+                                            named_local_size, names_local_size)
 from cltess.bench.suite import device_info, machine_info  # noqa: E402
 from cltess.kinds import BEZIER  # noqa: E402
 from cltess.tessellation import VERTEX_RECORD  # noqa: E402
@@ -197,11 +200,13 @@ def main(argv=None) -> int:
         lanes_stored = build(context, device, kernel_dir(), probe_source, "vertices", part.pattern, forms + ("STORE_LANES",))
     octets = (16 - 1 + 7) // 8  # rows of a level-16 patch, 8 per work-item
 
-    def launch_stage4(kernel, local=None):  # the engine's kernel takes its output's capacity (batch_fits); a tree before not
+    engine_local = named_local_size(per_patch) if names_local_size(device) else None  # as the engine launches
+
+    def launch_stage4(kernel, local=engine_local):  # the engine's kernel takes its output's capacity (batch_fits); a tree before not
         capacity = (np.uint64(vertices),) if kernel.num_args == len(common) + 1 + len(buffers) else ()
         return lambda: kernel(queue, per_patch, local, *common, *capacity, *buffers)
 
-    def launch_stage5(kernel, local=None):
+    def launch_stage5(kernel, local=engine_local):
         capacity = (np.uint64(plan.num_indices),) if kernel.num_args == 8 else ()
         return lambda: kernel(queue, per_patch, local, plan.factors.data, plan.vertex_offsets.data,
                               plan.index_offsets.data, np.uint32(0), np.uint32(patches), np.uint64(0), *capacity,
@@ -216,7 +221,7 @@ def main(argv=None) -> int:
             record.setdefault("digests", {})[f"{label}stage 4"] = digest(out)
             measure(f"{label}stage 5 (indices){suffix}", launch_stage5(indices_kernel))
             record["digests"][f"{label}stage 5"] = digest([triangles])
-        for local in args.local_sizes:  # this tree's kernels with a work-group size given (the engine gives none)
+        for local in args.local_sizes:  # this tree's kernels with a work-group size given
             vertices_kernel, indices_kernel = kernels[""]
             measure(f"stage 4 (vertices), local {local}{suffix}", launch_stage4(vertices_kernel, (local,)))
             record["digests"][f"stage 4, local {local}"] = digest(out)

@@ -120,6 +120,62 @@ ALWAYS_INLINE int imax(int a, int b) { return a < b ? b : a; }
 #define POCL_INLINE inline
 #endif
 
+/* --- eight lanes (issue 15, the CPU line) -----------------------------------------------------
+ * Stage 4's rows KIND_ROW_LANES points at once (stages/rows.h, kinds/bezier.h): by default on PoCL
+ * for x86-64, where it is 1.2-1.5x faster (bench/RESULTS.md, "Session 13"); -D CLTESS_ROW_LANES=1
+ * forces it anywhere (Oclgrind's scenario: tests/oclgrind_scenarios.py), =0 turns it off.  Clang's
+ * vector extensions (__builtin_shufflevector, ext_vector_type), which every runtime here builds
+ * with: PoCL keeps vload8, vstore8, shuffle and any out of line. */
+#ifndef CLTESS_ROW_LANES
+#define CLTESS_ROW_LANES CLTESS_POCL_FORMS
+#endif
+#if CLTESS_ROW_LANES
+/* Vectors of 8 that may sit at any float or int (vmovups). */
+typedef float float8_at_float __attribute__((ext_vector_type(8), aligned(4)));
+typedef int int8_at_int __attribute__((ext_vector_type(8), aligned(4)));
+/* Eight float4 as their four components' lanes: c[0] = (v[0].x, .., v[7].x), .. c[3] the .w. */
+ALWAYS_INLINE void lanes_of(const float4 v[8], float8 c[4])
+{
+    float8 p04 = __builtin_shufflevector(v[0], v[4], 0, 1, 2, 3, 4, 5, 6, 7);
+    float8 p15 = __builtin_shufflevector(v[1], v[5], 0, 1, 2, 3, 4, 5, 6, 7);
+    float8 p26 = __builtin_shufflevector(v[2], v[6], 0, 1, 2, 3, 4, 5, 6, 7);
+    float8 p37 = __builtin_shufflevector(v[3], v[7], 0, 1, 2, 3, 4, 5, 6, 7);
+    float8 xy01 = __builtin_shufflevector(p04, p15, 0, 8, 1, 9, 4, 12, 5, 13);  /* x0 x1 y0 y1 | x4 x5 y4 y5 */
+    float8 zw01 = __builtin_shufflevector(p04, p15, 2, 10, 3, 11, 6, 14, 7, 15);
+    float8 xy23 = __builtin_shufflevector(p26, p37, 0, 8, 1, 9, 4, 12, 5, 13);
+    float8 zw23 = __builtin_shufflevector(p26, p37, 2, 10, 3, 11, 6, 14, 7, 15);
+    c[0] = __builtin_shufflevector(xy01, xy23, 0, 1, 8, 9, 4, 5, 12, 13);
+    c[1] = __builtin_shufflevector(xy01, xy23, 2, 3, 10, 11, 6, 7, 14, 15);
+    c[2] = __builtin_shufflevector(zw01, zw23, 0, 1, 8, 9, 4, 5, 12, 13);
+    c[3] = __builtin_shufflevector(zw01, zw23, 2, 3, 10, 11, 6, 7, 14, 15);
+}
+/* store3 of eight lanes' (x, y, z) to records at .. at + 7, as three vector stores. */
+ALWAYS_INLINE void store3_lanes(float8 x, float8 y, float8 z, ulong at, __global float *out)
+{
+    float8 xy_lo = __builtin_shufflevector(x, y, 0, 8, 1, 9, 2, 10, 3, 11);       /* x0 y0 x1 y1 x2 y2 x3 y3 */
+    float8 xy_hi = __builtin_shufflevector(x, y, 4, 12, 5, 13, 6, 14, 7, 15);     /* x4 y4 .. x7 y7 */
+    float8 xy_mid = __builtin_shufflevector(xy_lo, xy_hi, 6, 7, 8, 9, 10, 11, 12, 13);  /* x3 y3 .. x6 y6 */
+    __global float8_at_float *to = (__global float8_at_float *)(out + 3 * at);
+    to[0] = __builtin_shufflevector(xy_lo, z, 0, 1, 8, 2, 3, 9, 4, 5);       /* x0 y0 z0 x1 y1 z1 x2 y2 */
+    to[1] = __builtin_shufflevector(xy_mid, z, 10, 0, 1, 11, 2, 3, 12, 4);   /* z2 x3 y3 z3 x4 y4 z4 x5 */
+    to[2] = __builtin_shufflevector(xy_hi, z, 3, 13, 4, 5, 14, 6, 7, 15);    /* y5 z5 x6 y6 z6 x7 y7 z7 */
+}
+/* store2 of eight lanes' (x, y). */
+ALWAYS_INLINE void store2_lanes(float8 x, float8 y, ulong at, __global float *out)
+{
+    __global float8_at_float *to = (__global float8_at_float *)(out + 2 * at);
+    to[0] = __builtin_shufflevector(x, y, 0, 8, 1, 9, 2, 10, 3, 11);
+    to[1] = __builtin_shufflevector(x, y, 4, 12, 5, 13, 6, 14, 7, 15);
+}
+/* Whether any of eight lanes is set (any() is a call on PoCL). */
+ALWAYS_INLINE int any_lane(int8 a)
+{
+    int4 b = a.lo | a.hi;
+    int2 c = b.lo | b.hi;
+    return (c.x | c.y) != 0;
+}
+#endif
+
 /* a / |a| where |a| > 0, else 0 (PN triangles' normals; silhouette vertices).  The root as sqrt
  * (inline on PoCL: sqrt1f above). */
 inline float3 unit_or_zero(float3 a)
@@ -475,6 +531,19 @@ inline void put_vertex(vertex_out out, ulong at, float3 position, float3 normal,
     out.patch_ids[at] = patch;
     out.object_ids[at] = object;
 }
+
+#if CLTESS_ROW_LANES
+/* put_vertex of eight lanes to records at .. at + 7: the same bytes, a field's eight at once. */
+ALWAYS_INLINE void put_vertex_lanes(vertex_out out, ulong at, const float8 position[3], const float8 normal[3],
+                                    float8 u, float8 v, int patch, int object)
+{
+    store3_lanes(position[0], position[1], position[2], at, out.positions);
+    store3_lanes(normal[0], normal[1], normal[2], at, out.normals);
+    store2_lanes(u, v, at, out.uv);
+    *(__global int8_at_int *)(out.patch_ids + at) = (int8)(patch);
+    *(__global int8_at_int *)(out.object_ids + at) = (int8)(object);
+}
+#endif
 
 /* One triangle: written when out is not null, always counted ("count" and "emit" modes of
  * pattern_primitives). */

@@ -1,9 +1,11 @@
 """Stage 4 (kernels/vertices.cl, Tessellator.stage_vertices) against reference.tessellate."""
 import numpy as np
+import pyopencl as cl
 import pyopencl.array as cl_array
 import pytest
 
 from cltess import reference
+from cltess.tessellation import VERTEX_RECORD
 from support import as_float32, random_patches
 from support.factors import random_factors, random_triangle_factors
 
@@ -141,3 +143,74 @@ def test_pn_boundary_points_are_bitwise_shared_and_corners_exact(tessellator, rn
         edge_b = out["positions"][first_b + 3:first_b + 3 + f + 1]  # ring of b: edge 1 starts at 3
         assert np.array_equal(edge_a, edge_b[::-1]), f
         assert np.array_equal(edge_a[[0, f]], a[[0, 1], :3])
+
+
+# --- a row's points eight at a time (kernels/common.h CLTESS_ROW_LANES) -------------------------
+
+def lanes_vertices(tessellator, patches, factors, lanes: int):
+    """Stage 4's per-patch kernel (stages/vertices.cl, forward differencing) built with
+    -D CLTESS_ROW_LANES=lanes, on the patches: its vertex arrays, and the value it saw."""
+    from cltess.backends.opencl.programs import composition, correctly_rounded_division, program_text
+    from cltess.kinds import BEZIER
+
+    ctx, q = tessellator.context, tessellator.queue
+    headers, defines = composition("vertices", kind=BEZIER, pattern=BEZIER.pattern)
+    source, options = program_text("vertices", headers, {**defines, "CLTESS_ROW_LANES": lanes})
+    program = cl.Program(ctx, source).build(options=options + correctly_rounded_division(ctx.devices[0]))
+    count = len(patches)
+    final = cl_array.to_device(q, factors)
+    vertex_offsets, _, _ = tessellator.stage_counts(final)
+    total = int(vertex_offsets[count].get())
+    out = {name: cl_array.zeros(q, (total, *shape), dtype) for name, dtype, shape in VERTEX_RECORD}
+    program.vertices(q, (-(-count // 64) * 64,), (64,),
+                     cl_array.to_device(q, patches.reshape(count, 16, 4).astype(np.float32)).data, final.data,
+                     vertex_offsets.data, cl_array.to_device(q, np.arange(count, dtype=np.int32) % 5).data,
+                     np.uint32(0), np.uint32(count), np.uint32(0), np.uint64(0), np.int32(1), np.uint64(total),
+                     *(a.data for a in out.values()))
+    return {name: a.get() for name, a in out.items()}
+
+
+def folded_patch() -> np.ndarray:
+    """A flat patch folded along u = 1/2: x's controls along u are 0, 1, 0, 1, so B_u.x is 3 (1 -
+    4 u (1 - u)), zero there, and t_u x t_v vanishes along that line (surface_normal's fall-backs
+    for some lanes of a row and not others)."""
+    u, v = np.meshgrid([0.0, 1.0, 0.0, 1.0], np.arange(4) / 3.0, indexing="xy")
+    return np.stack([u, v, 0.1 * u * v, np.ones_like(u)], -1)
+
+
+def test_row_lanes_are_the_rows_point_by_point(tessellator, rng):
+    """Stage 4's interior rows KIND_ROW_LANES points at once (stages/rows.h, kinds/bezier.h: on
+    by default on PoCL for x86-64) write bitwise what one point at a time writes, at every row
+    length around the lanes (7 points: no lanes; 8: one set; 9 .. 15: the last set overlaps the
+    one before; 16 .. 63), with the lanes that take surface_normal's fall-backs: a patch folded
+    so that t_u x t_v vanishes along a line (some lanes of a row, not the others), a patch flat on
+    a line (every lane), and squared normals below FLT_MIN (coordinates of 1e-10) or infinite
+    (1e10) where t_u x t_v does not vanish against the tangents: length's scaled branches.  The lanes are PoCL's builtin forms (common.h); on a
+    device whose builtins differ they are not expected to match, so this runs on PoCL."""
+    from cltess.pipeline import Tessellator
+    try:
+        pocl = Tessellator("Portable Computing Language")
+    except Exception as error:  # noqa: BLE001  (no PoCL here: the lanes are PoCL's default only)
+        pytest.skip(f"no PoCL device: {error}")
+    if "x86_64" not in pocl.device.version:
+        pytest.skip("the lanes are PoCL's forms on x86-64")
+    patches = [random_patches(rng, 120, spread=1.0)]
+    patches.append(np.stack([folded_patch()] * 8))
+    patches.append(np.stack([folded_patch() * [1.0, 0.0, 0.0, 1.0]] * 2))  # on the line y = z = 0
+    for scale in (1e-10, 1e10):
+        tiny = random_patches(rng, 6, spread=1.0)
+        tiny[..., :3] *= scale
+        patches.append(tiny)
+    patches = np.concatenate(patches)
+    count = len(patches)
+    factors = random_factors(rng, count, high=64)
+    whole = rng.random(count) < 0.5  # uniform rows of every length from 1 to 63 points
+    factors[whole] = (np.arange(count) % 64 + 1)[whole, None]
+    factors[-20:] = 16
+    with_lanes = lanes_vertices(pocl, patches, factors, 1)
+    alone = lanes_vertices(pocl, patches, factors, 0)
+    for name in with_lanes:
+        differ = with_lanes[name].view(np.uint32) != alone[name].view(np.uint32)
+        assert not differ.any(), f"{name}: {differ.any(axis=-1).sum() if differ.ndim > 1 else differ.sum()} differ"
+    normals = with_lanes["normals"]
+    assert (np.abs(normals - [0.0, 0.0, 1.0]).max(axis=1) == 0).sum() > 100  # the flat patches' +z

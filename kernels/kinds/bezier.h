@@ -273,4 +273,89 @@ ALWAYS_INLINE void kind_row_next(__private const kind_patch *patch, __private ki
     *normal = surface_normal(patch->t, x.x, x.y, value, p, row->s_u[0], row->s_v[0]);
 }
 
+#if CLTESS_ROW_LANES
+/* Where CLTESS_ROW_LANES (common.h: PoCL on x86-64), a row's points KIND_ROW_LANES at a time (stages/rows.h
+ * put_rows).  The differences are stepped point by point as kind_row_next does; the lanes are the
+ * row's last KIND_ROW_LANES points stepped so far (a row's last call steps fewer, and its lanes
+ * overlap the call before: the same points, the same bits).  Their positions and normals are made
+ * with float8 arithmetic, component by component the same operations in the same order as
+ * projected, tangent_cross and unit_or (FP_CONTRACT is off: common.h), so the same bits.  Two
+ * shortcuts of those give the same bits without their branch: h.xyz / h.w where h.w is 1 is h.xyz
+ * (projected's comment), and a zero component divided by len > 0 is itself (unit_or's).  A lane
+ * whose t_u x t_v is (nearly) vanishing, or whose dot(n, n) takes length's rescaling branches
+ * (below FLT_MIN, or infinite), gets its normal from surface_normal alone (kind_row_lane). */
+#define KIND_ROW_LANES 8
+typedef struct {
+    float4 s[KIND_ROW_LANES], s_u[KIND_ROW_LANES], s_v[KIND_ROW_LANES];  /* B, B_u, B_v of each lane's point */
+    float8 position[3], normal[3];  /* by component, a lane a point */
+    int8 alone;  /* nonzero: the lane's normal by surface_normal (its fall-backs) */
+} kind_row_lanes;
+
+/* Step `count` (1 .. KIND_ROW_LANES) more points of the row into the lanes; a count below
+ * KIND_ROW_LANES keeps the earlier lanes' last points in front of them. */
+ALWAYS_INLINE void kind_row_next_lanes(__private const kind_patch *patch, __private kind_row *row, int count,
+                                       __private kind_row_lanes *lanes)
+{
+    if (count == KIND_ROW_LANES) {
+        __attribute__((opencl_unroll_hint))
+        for (int k = 0; k < KIND_ROW_LANES; ++k) {
+            step_differences(row->s);
+            step_differences(row->s_u);
+            step_differences(row->s_v);
+            lanes->s[k] = row->s[0];
+            lanes->s_u[k] = row->s_u[0];
+            lanes->s_v[k] = row->s_v[0];
+        }
+    } else {
+        int kept = KIND_ROW_LANES - count;
+        for (int k = 0; k < kept; ++k) {
+            lanes->s[k] = lanes->s[k + count];
+            lanes->s_u[k] = lanes->s_u[k + count];
+            lanes->s_v[k] = lanes->s_v[k + count];
+        }
+        for (int k = kept; k < KIND_ROW_LANES; ++k) {
+            step_differences(row->s);
+            step_differences(row->s_u);
+            step_differences(row->s_v);
+            lanes->s[k] = row->s[0];
+            lanes->s_u[k] = row->s_u[0];
+            lanes->s_v[k] = row->s_v[0];
+        }
+    }
+    float8 s[4], s_u[4], s_v[4];
+    lanes_of(lanes->s, s);
+    lanes_of(lanes->s_u, s_u);
+    lanes_of(lanes->s_v, s_v);
+    float8 px = s[0] / s[3], py = s[1] / s[3], pz = s[2] / s[3];
+    lanes->position[0] = px + patch->centre.x;
+    lanes->position[1] = py + patch->centre.y;
+    lanes->position[2] = pz + patch->centre.z;
+    float8 tux = s_u[0] - s_u[3] * px, tuy = s_u[1] - s_u[3] * py, tuz = s_u[2] - s_u[3] * pz;
+    float8 tvx = s_v[0] - s_v[3] * px, tvy = s_v[1] - s_v[3] * py, tvz = s_v[2] - s_v[3] * pz;
+    float8 nx = tuy * tvz - tuz * tvy, ny = tuz * tvx - tux * tvz, nz = tux * tvy - tuy * tvx;  /* cross3 */
+    float8 scale = (tux * tux + tuy * tuy + tuz * tuz) + (tvx * tvx + tvy * tvy + tvz * tvz);  /* dot3f */
+    float8 nn = nx * nx + ny * ny + nz * nz;
+    int8 ok = nn > NORMAL_DEGENERATE * NORMAL_DEGENERATE * scale * scale;  /* tangent_cross */
+    lanes->alone = ~(ok & (nn >= FLT_MIN) & (nn != INFINITY));  /* length3's plain branch */
+    float8 len = (float8)(__builtin_sqrtf(nn.s0), __builtin_sqrtf(nn.s1), __builtin_sqrtf(nn.s2),
+                          __builtin_sqrtf(nn.s3), __builtin_sqrtf(nn.s4), __builtin_sqrtf(nn.s5),
+                          __builtin_sqrtf(nn.s6), __builtin_sqrtf(nn.s7));  /* sqrt(float8) is a call on PoCL */
+    lanes->normal[0] = nx / len;
+    lanes->normal[1] = ny / len;
+    lanes->normal[2] = nz / len;
+}
+
+/* Lane k's position and normal (x its domain point, for the normal's fall-backs). */
+ALWAYS_INLINE void kind_row_lane(__private const kind_patch *patch, __private const kind_row_lanes *lanes, int k,
+                                 float3 x, __private float3 *position, __private float3 *normal)
+{
+    *position = (float3)(lanes->position[0][k], lanes->position[1][k], lanes->position[2][k]);
+    if (lanes->alone[k])
+        *normal = surface_normal(patch->t, x.x, x.y, lanes->s[k], projected(lanes->s[k]), lanes->s_u[k],
+                                 lanes->s_v[k]);
+    else
+        *normal = (float3)(lanes->normal[0][k], lanes->normal[1][k], lanes->normal[2][k]);
+}
+#endif
+
 #endif

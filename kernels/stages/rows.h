@@ -121,6 +121,36 @@ ALWAYS_INLINE void put_rows(__private const kind_patch *patch, int4 f, int colla
         if (forward_differencing) {
             kind_row row;
             kind_row_begin(patch, pattern_row_point(f, j, 0), pattern_row_point(f, j, steps), steps, &row);
+#if defined(KIND_ROW_LANES) && !PATTERN_CHORD_POINTS  /* KIND_ROW_LANES points at once (kinds/bezier.h on PoCL) */
+            if (steps - 1 >= KIND_ROW_LANES) {
+                kind_row_lanes lanes;
+                for (int i = 1; i < steps;) {
+                    int count = imin(KIND_ROW_LANES, steps - i);
+                    kind_row_next_lanes(patch, &row, count, &lanes);
+                    i += count;
+                    at += count;
+                    ulong first = at - KIND_ROW_LANES;  /* the lanes: the row's points i - 8 .. i - 1 */
+                    if (!any_lane(lanes.alone)) {
+                        float u[KIND_ROW_LANES], v[KIND_ROW_LANES];
+                        __attribute__((opencl_unroll_hint))
+                        for (int k = 0; k < KIND_ROW_LANES; ++k) {
+                            float3 x = pattern_row_point(f, j, i - KIND_ROW_LANES + k);
+                            u[k] = x.x;
+                            v[k] = x.y;
+                        }
+                        put_vertex_lanes(out, first, lanes.position, lanes.normal, *(float8 *)u, *(float8 *)v, p,
+                                         object);
+                        continue;
+                    }
+                    for (int k = 0; k < KIND_ROW_LANES; ++k) {
+                        float3 x = pattern_row_point(f, j, i - KIND_ROW_LANES + k);
+                        kind_row_lane(patch, &lanes, k, x, &position, &normal);
+                        put_vertex(out, first + k, position, normal, x.xy, p, object);
+                    }
+                }
+                continue;
+            }
+#endif
             for (int i = 1; i < steps; ++i) {
                 float3 x = pattern_row_point(f, j, i);
                 kind_row_next(patch, &row, x, &position, &normal);
