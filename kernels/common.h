@@ -123,9 +123,10 @@ ALWAYS_INLINE int imax(int a, int b) { return a < b ? b : a; }
 /* --- eight lanes (issue 15, the CPU line) -----------------------------------------------------
  * Stage 4's rows KIND_ROW_LANES points at once (stages/rows.h, kinds/bezier.h): by default on PoCL
  * for x86-64, where it is 1.2-1.5x faster (bench/RESULTS.md, "Session 13"); -D CLTESS_ROW_LANES=1
- * forces it anywhere (Oclgrind's scenario: tests/oclgrind_scenarios.py), =0 turns it off.  Clang's
- * vector extensions (__builtin_shufflevector, ext_vector_type), which every runtime here builds
- * with: PoCL keeps vload8, vstore8, shuffle and any out of line. */
+ * forces it anywhere (Oclgrind's scenarios: tests/oclgrind_scenarios.py ROW_LANES), =0 turns it
+ * off.  The lanes are written without vload8, vstore8, shuffle, sqrt(float8) and all, which PoCL
+ * keeps out of line; the unaligned vector type is Clang's extension, which every runtime here
+ * builds with. */
 #ifndef CLTESS_ROW_LANES
 #define CLTESS_ROW_LANES CLTESS_POCL_FORMS
 #endif
@@ -136,43 +137,33 @@ typedef int int8_at_int __attribute__((ext_vector_type(8), aligned(4)));
 /* Eight float4 as their four components' lanes: c[0] = (v[0].x, .., v[7].x), .. c[3] the .w. */
 ALWAYS_INLINE void lanes_of(const float4 v[8], float8 c[4])
 {
-    float8 p04 = __builtin_shufflevector(v[0], v[4], 0, 1, 2, 3, 4, 5, 6, 7);
-    float8 p15 = __builtin_shufflevector(v[1], v[5], 0, 1, 2, 3, 4, 5, 6, 7);
-    float8 p26 = __builtin_shufflevector(v[2], v[6], 0, 1, 2, 3, 4, 5, 6, 7);
-    float8 p37 = __builtin_shufflevector(v[3], v[7], 0, 1, 2, 3, 4, 5, 6, 7);
-    float8 xy01 = __builtin_shufflevector(p04, p15, 0, 8, 1, 9, 4, 12, 5, 13);  /* x0 x1 y0 y1 | x4 x5 y4 y5 */
-    float8 zw01 = __builtin_shufflevector(p04, p15, 2, 10, 3, 11, 6, 14, 7, 15);
-    float8 xy23 = __builtin_shufflevector(p26, p37, 0, 8, 1, 9, 4, 12, 5, 13);
-    float8 zw23 = __builtin_shufflevector(p26, p37, 2, 10, 3, 11, 6, 14, 7, 15);
-    c[0] = __builtin_shufflevector(xy01, xy23, 0, 1, 8, 9, 4, 5, 12, 13);
-    c[1] = __builtin_shufflevector(xy01, xy23, 2, 3, 10, 11, 6, 7, 14, 15);
-    c[2] = __builtin_shufflevector(zw01, zw23, 0, 1, 8, 9, 4, 5, 12, 13);
-    c[3] = __builtin_shufflevector(zw01, zw23, 2, 3, 10, 11, 6, 7, 14, 15);
+    c[0] = (float8)(v[0].x, v[1].x, v[2].x, v[3].x, v[4].x, v[5].x, v[6].x, v[7].x);
+    c[1] = (float8)(v[0].y, v[1].y, v[2].y, v[3].y, v[4].y, v[5].y, v[6].y, v[7].y);
+    c[2] = (float8)(v[0].z, v[1].z, v[2].z, v[3].z, v[4].z, v[5].z, v[6].z, v[7].z);
+    c[3] = (float8)(v[0].w, v[1].w, v[2].w, v[3].w, v[4].w, v[5].w, v[6].w, v[7].w);
 }
 /* store3 of eight lanes' (x, y, z) to records at .. at + 7, as three vector stores. */
 ALWAYS_INLINE void store3_lanes(float8 x, float8 y, float8 z, ulong at, __global float *out)
 {
-    float8 xy_lo = __builtin_shufflevector(x, y, 0, 8, 1, 9, 2, 10, 3, 11);       /* x0 y0 x1 y1 x2 y2 x3 y3 */
-    float8 xy_hi = __builtin_shufflevector(x, y, 4, 12, 5, 13, 6, 14, 7, 15);     /* x4 y4 .. x7 y7 */
-    float8 xy_mid = __builtin_shufflevector(xy_lo, xy_hi, 6, 7, 8, 9, 10, 11, 12, 13);  /* x3 y3 .. x6 y6 */
     __global float8_at_float *to = (__global float8_at_float *)(out + 3 * at);
-    to[0] = __builtin_shufflevector(xy_lo, z, 0, 1, 8, 2, 3, 9, 4, 5);       /* x0 y0 z0 x1 y1 z1 x2 y2 */
-    to[1] = __builtin_shufflevector(xy_mid, z, 10, 0, 1, 11, 2, 3, 12, 4);   /* z2 x3 y3 z3 x4 y4 z4 x5 */
-    to[2] = __builtin_shufflevector(xy_hi, z, 3, 13, 4, 5, 14, 6, 7, 15);    /* y5 z5 x6 y6 z6 x7 y7 z7 */
+    to[0] = (float8)(x.s0, y.s0, z.s0, x.s1, y.s1, z.s1, x.s2, y.s2);
+    to[1] = (float8)(z.s2, x.s3, y.s3, z.s3, x.s4, y.s4, z.s4, x.s5);
+    to[2] = (float8)(y.s5, z.s5, x.s6, y.s6, z.s6, x.s7, y.s7, z.s7);
 }
 /* store2 of eight lanes' (x, y). */
 ALWAYS_INLINE void store2_lanes(float8 x, float8 y, ulong at, __global float *out)
 {
     __global float8_at_float *to = (__global float8_at_float *)(out + 2 * at);
-    to[0] = __builtin_shufflevector(x, y, 0, 8, 1, 9, 2, 10, 3, 11);
-    to[1] = __builtin_shufflevector(x, y, 4, 12, 5, 13, 6, 14, 7, 15);
+    to[0] = (float8)(x.s0, y.s0, x.s1, y.s1, x.s2, y.s2, x.s3, y.s3);
+    to[1] = (float8)(x.s4, y.s4, x.s5, y.s5, x.s6, y.s6, x.s7, y.s7);
 }
-/* Whether any of eight lanes is set (any() is a call on PoCL). */
-ALWAYS_INLINE int any_lane(int8 a)
+/* Whether every one of eight lanes is nonzero (all() is a call on PoCL).  Any nonzero: on Oclgrind
+ * a vector comparison's true came out 1 after an &, where OpenCL says -1. */
+ALWAYS_INLINE int every_lane(int8 a)
 {
-    int4 b = a.lo | a.hi;
-    int2 c = b.lo | b.hi;
-    return (c.x | c.y) != 0;
+    int4 b = a.lo & a.hi;
+    int2 c = b.lo & b.hi;
+    return (c.x & c.y) != 0;
 }
 #endif
 

@@ -288,7 +288,7 @@ ALWAYS_INLINE void kind_row_next(__private const kind_patch *patch, __private ki
 typedef struct {
     float4 s[KIND_ROW_LANES], s_u[KIND_ROW_LANES], s_v[KIND_ROW_LANES];  /* B, B_u, B_v of each lane's point */
     float8 position[3], normal[3];  /* by component, a lane a point */
-    int8 alone;  /* nonzero: the lane's normal by surface_normal (its fall-backs) */
+    int8 plain;  /* zero: the lane's normal by surface_normal (its fall-backs) */
 } kind_row_lanes;
 
 /* Step `count` (1 .. KIND_ROW_LANES) more points of the row into the lanes; a count below
@@ -336,10 +336,9 @@ ALWAYS_INLINE void kind_row_next_lanes(__private const kind_patch *patch, __priv
     float8 scale = (tux * tux + tuy * tuy + tuz * tuz) + (tvx * tvx + tvy * tvy + tvz * tvz);  /* dot3f */
     float8 nn = nx * nx + ny * ny + nz * nz;
     int8 ok = nn > NORMAL_DEGENERATE * NORMAL_DEGENERATE * scale * scale;  /* tangent_cross */
-    lanes->alone = ~(ok & (nn >= FLT_MIN) & (nn != INFINITY));  /* length3's plain branch */
-    float8 len = (float8)(__builtin_sqrtf(nn.s0), __builtin_sqrtf(nn.s1), __builtin_sqrtf(nn.s2),
-                          __builtin_sqrtf(nn.s3), __builtin_sqrtf(nn.s4), __builtin_sqrtf(nn.s5),
-                          __builtin_sqrtf(nn.s6), __builtin_sqrtf(nn.s7));  /* sqrt(float8) is a call on PoCL */
+    lanes->plain = ok & (nn >= FLT_MIN) & (nn != INFINITY);  /* length3's plain branch */
+    float8 len = (float8)(sqrt1f(nn.s0), sqrt1f(nn.s1), sqrt1f(nn.s2), sqrt1f(nn.s3), sqrt1f(nn.s4), sqrt1f(nn.s5),
+                          sqrt1f(nn.s6), sqrt1f(nn.s7));  /* one vsqrtps on PoCL, where sqrt(float8) is a call */
     lanes->normal[0] = nx / len;
     lanes->normal[1] = ny / len;
     lanes->normal[2] = nz / len;
@@ -350,7 +349,7 @@ ALWAYS_INLINE void kind_row_lane(__private const kind_patch *patch, __private co
                                  float3 x, __private float3 *position, __private float3 *normal)
 {
     *position = (float3)(lanes->position[0][k], lanes->position[1][k], lanes->position[2][k]);
-    if (lanes->alone[k])
+    if (!lanes->plain[k])
         *normal = surface_normal(patch->t, x.x, x.y, lanes->s[k], projected(lanes->s[k]), lanes->s_u[k],
                                  lanes->s_v[k]);
     else

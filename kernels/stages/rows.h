@@ -130,7 +130,7 @@ ALWAYS_INLINE void put_rows(__private const kind_patch *patch, int4 f, int colla
                     i += count;
                     at += count;
                     ulong first = at - KIND_ROW_LANES;  /* the lanes: the row's points i - 8 .. i - 1 */
-                    if (!any_lane(lanes.alone)) {
+                    if (every_lane(lanes.plain)) {
                         float u[KIND_ROW_LANES], v[KIND_ROW_LANES];
                         __attribute__((opencl_unroll_hint))
                         for (int k = 0; k < KIND_ROW_LANES; ++k) {
