@@ -121,16 +121,16 @@ ALWAYS_INLINE int imax(int a, int b) { return a < b ? b : a; }
 #endif
 
 /* --- eight lanes (issue 15, the CPU line) -----------------------------------------------------
- * Stage 4's rows KIND_ROW_LANES points at once (stages/rows.h, kinds/bezier.h): by default on PoCL
- * for x86-64, where it is 1.2-1.5x faster (bench/RESULTS.md, "Session 13"); -D CLTESS_ROW_LANES=1
- * forces it anywhere (Oclgrind's scenarios: tests/oclgrind_scenarios.py ROW_LANES), =0 turns it
- * off.  The lanes are written without vload8, vstore8, shuffle, sqrt(float8) and all, which PoCL
+ * Stage 4's rows and ring edges KIND_LANES points at once (stages/rows.h, kinds/bezier.h): by
+ * default on PoCL for x86-64, where the per-patch stage 4 of uniform level 16 takes 0.72x the
+ * CPU time (bench/RESULTS.md, "Session 13, lead"); -D CLTESS_LANES=1 forces it anywhere
+ * (Oclgrind's scenarios: tests/oclgrind_scenarios.py LANES), =0 turns it off.  The lanes are written without vload8, vstore8, shuffle, sqrt(float8) and all, which PoCL
  * keeps out of line; the unaligned vector type is Clang's extension, which every runtime here
  * builds with. */
-#ifndef CLTESS_ROW_LANES
-#define CLTESS_ROW_LANES CLTESS_POCL_FORMS
+#ifndef CLTESS_LANES
+#define CLTESS_LANES CLTESS_POCL_FORMS
 #endif
-#if CLTESS_ROW_LANES
+#if CLTESS_LANES
 /* Vectors of 8 that may sit at any float or int (vmovups). */
 typedef float float8_at_float __attribute__((ext_vector_type(8), aligned(4)));
 typedef int int8_at_int __attribute__((ext_vector_type(8), aligned(4)));
@@ -141,6 +141,13 @@ ALWAYS_INLINE void lanes_of(const float4 v[8], float8 c[4])
     c[1] = (float8)(v[0].y, v[1].y, v[2].y, v[3].y, v[4].y, v[5].y, v[6].y, v[7].y);
     c[2] = (float8)(v[0].z, v[1].z, v[2].z, v[3].z, v[4].z, v[5].z, v[6].z, v[7].z);
     c[3] = (float8)(v[0].w, v[1].w, v[2].w, v[3].w, v[4].w, v[5].w, v[6].w, v[7].w);
+}
+/* Eight float3 as their components' lanes. */
+ALWAYS_INLINE void lanes_of3(const float3 v[8], float8 c[3])
+{
+    c[0] = (float8)(v[0].x, v[1].x, v[2].x, v[3].x, v[4].x, v[5].x, v[6].x, v[7].x);
+    c[1] = (float8)(v[0].y, v[1].y, v[2].y, v[3].y, v[4].y, v[5].y, v[6].y, v[7].y);
+    c[2] = (float8)(v[0].z, v[1].z, v[2].z, v[3].z, v[4].z, v[5].z, v[6].z, v[7].z);
 }
 /* store3 of eight lanes' (x, y, z) to records at .. at + 7, as three vector stores. */
 ALWAYS_INLINE void store3_lanes(float8 x, float8 y, float8 z, ulong at, __global float *out)
@@ -350,16 +357,21 @@ inline float4 boundary_point(const float4 c[4], edge_param t)
         return c[0];
     float4 q[4];
     int forward = 2 * k < f;
+    __attribute__((opencl_unroll_hint))  /* unrolled, q stays in registers (PoCL left it in memory) */
     for (int i = 0; i < 4; ++i)
         q[i] = forward ? c[i] : c[3 - i];
     if (2 * k == f) {
+        __attribute__((opencl_unroll_hint))
         for (int level = 3; level > 0; --level)
+            __attribute__((opencl_unroll_hint))
             for (int i = 0; i < level; ++i)
                 q[i] = (q[i] + q[i + 1]) * 0.5f;
     } else {
         int from_end;
         float s = edge_near_fraction(t, &from_end);  /* whole factors: min(k, f - k) / f */
+        __attribute__((opencl_unroll_hint))
         for (int level = 3; level > 0; --level)
+            __attribute__((opencl_unroll_hint))
             for (int i = 0; i < level; ++i)
                 q[i] = lerp4(q[i], q[i + 1], s);
     }
@@ -523,7 +535,7 @@ inline void put_vertex(vertex_out out, ulong at, float3 position, float3 normal,
     out.object_ids[at] = object;
 }
 
-#if CLTESS_ROW_LANES
+#if CLTESS_LANES
 /* put_vertex of eight lanes to records at .. at + 7: the same bytes, a field's eight at once. */
 ALWAYS_INLINE void put_vertex_lanes(vertex_out out, ulong at, const float8 position[3], const float8 normal[3],
                                     float8 u, float8 v, int patch, int object)

@@ -466,12 +466,12 @@ UNINITIALIZED_SKIPPED = {
         "(tests/test_semi_uniform_levels.py) and the checks pass is clean.",
 }
 
-#: Scenarios whose stage 4 makes a row's points eight at a time (kernels/common.h CLTESS_ROW_LANES,
-#: PoCL's default on x86-64, forced here: -D CLTESS_ROW_LANES=1), on rows of 9 to 23 points (the
-#: last eight overlap the eight before), the rational sphere's with its collapsed poles: the base
-#: scenario and options to change.
-ROW_LANES = {"uniform_fine_by_row_lanes": ("uniform_fine", {}),
-             "rational_sphere_by_row_lanes": ("rational_sphere", {"eps": 0.001, "max_factor": 12})}
+#: Scenarios whose stage 4 makes a row's or a ring edge's points eight at a time (kernels/common.h
+#: CLTESS_LANES, PoCL's default on x86-64, forced here: -D CLTESS_LANES=1), on rows and edges of 9
+#: to 24 points (the last eight overlap the eight before), the rational sphere's with its
+#: collapsed poles: the base scenario and options to change.
+LANES = {"uniform_fine_by_lanes": ("uniform_fine", {}),
+             "rational_sphere_by_lanes": ("rational_sphere", {"eps": 0.001, "max_factor": 12})}
 
 #: Scenarios whose stage 4 runs a work-item per (patch, row) (stages/vertex_rows.cl), with 3
 #: work-items per patch so that the last one does the remaining rows too.
@@ -635,15 +635,15 @@ def run_scenario(name: str, tessellator, out_dir: Path) -> dict:
             tess = tessellator.emit(plan, 0, plan.num_patches)
         finally:
             tessellator.rows_in_parallel, opencl.MAX_ROWS_PER_PATCH = saved
-    elif name in ROW_LANES:
+    elif name in LANES:
         import os
 
         from cltess.backends.opencl.programs import Programs
 
-        base, changes = ROW_LANES[name]
+        base, changes = LANES[name]
         scene, options = SCENARIOS[base]()
         saved = tessellator.programs, os.environ.get("CLTESS_BUILD_OPTIONS")
-        os.environ["CLTESS_BUILD_OPTIONS"] = "-DCLTESS_ROW_LANES=1"
+        os.environ["CLTESS_BUILD_OPTIONS"] = "-DCLTESS_LANES=1"
         tessellator.programs = Programs(tessellator.context)  # built again, with the option
         try:
             tess = tessellator.tessellate(scene, **{**options, **changes})

@@ -145,17 +145,17 @@ def test_pn_boundary_points_are_bitwise_shared_and_corners_exact(tessellator, rn
         assert np.array_equal(edge_a[[0, f]], a[[0, 1], :3])
 
 
-# --- a row's points eight at a time (kernels/common.h CLTESS_ROW_LANES) -------------------------
+# --- eight points at a time (kernels/common.h CLTESS_LANES) -----------------------------------
 
 def lanes_vertices(tessellator, patches, factors, lanes: int):
     """Stage 4's per-patch kernel (stages/vertices.cl, forward differencing) built with
-    -D CLTESS_ROW_LANES=lanes, on the patches: its vertex arrays, and the value it saw."""
+    -D CLTESS_LANES=lanes, on the patches: its vertex arrays."""
     from cltess.backends.opencl.programs import composition, correctly_rounded_division, program_text
     from cltess.kinds import BEZIER
 
     ctx, q = tessellator.context, tessellator.queue
     headers, defines = composition("vertices", kind=BEZIER, pattern=BEZIER.pattern)
-    source, options = program_text("vertices", headers, {**defines, "CLTESS_ROW_LANES": lanes})
+    source, options = program_text("vertices", headers, {**defines, "CLTESS_LANES": lanes})
     program = cl.Program(ctx, source).build(options=options + correctly_rounded_division(ctx.devices[0]))
     count = len(patches)
     final = cl_array.to_device(q, factors)
@@ -178,15 +178,17 @@ def folded_patch() -> np.ndarray:
     return np.stack([u, v, 0.1 * u * v, np.ones_like(u)], -1)
 
 
-def test_row_lanes_are_the_rows_point_by_point(tessellator, rng):
-    """Stage 4's interior rows KIND_ROW_LANES points at once (stages/rows.h, kinds/bezier.h: on
-    by default on PoCL for x86-64) write bitwise what one point at a time writes, at every row
-    length around the lanes (7 points: no lanes; 8: one set; 9 .. 15: the last set overlaps the
-    one before; 16 .. 63), with the lanes that take surface_normal's fall-backs: a patch folded
-    so that t_u x t_v vanishes along a line (some lanes of a row, not the others), a patch flat on
-    a line (every lane), and squared normals below FLT_MIN (coordinates of 1e-10) or infinite
-    (1e10) where t_u x t_v does not vanish against the tangents: length's scaled branches.  The lanes are PoCL's builtin forms (common.h); on a
-    device whose builtins differ they are not expected to match, so this runs on PoCL."""
+def test_lanes_are_the_points_one_by_one(rng):
+    """Stage 4's interior rows and ring edges KIND_LANES points at once (stages/rows.h,
+    kinds/bezier.h: on by default on PoCL for x86-64) write bitwise what one point at a time
+    writes, at every row and edge length around the lanes (7 points: no lanes; 8: one set; 9 ..
+    15: the last set overlaps the one before; 16 .. 63; transition patterns' edges of other
+    lengths), with the lanes that take surface_normal's fall-backs: a patch folded so that t_u x
+    t_v vanishes along a line (some lanes of a row, not the others), a patch flat on a line (every
+    lane), patches with a collapsed edge, and squared normals below FLT_MIN (coordinates of 1e-10)
+    or infinite (1e10) where t_u x t_v does not vanish against the tangents: length's scaled
+    branches.  The lanes are PoCL's builtin forms (common.h); on a device whose builtins differ
+    they are not expected to match, so this runs on PoCL."""
     from cltess.pipeline import Tessellator
     try:
         pocl = Tessellator("Portable Computing Language")
@@ -197,6 +199,9 @@ def test_row_lanes_are_the_rows_point_by_point(tessellator, rng):
     patches = [random_patches(rng, 120, spread=1.0)]
     patches.append(np.stack([folded_patch()] * 8))
     patches.append(np.stack([folded_patch() * [1.0, 0.0, 0.0, 1.0]] * 2))  # on the line y = z = 0
+    collapsed = random_patches(rng, 6, spread=1.0)
+    collapsed[:, 0] = collapsed[:, 0, :1]  # edge 0 (v = 0) one point, as the teapot's lid
+    patches.append(collapsed)
     for scale in (1e-10, 1e10):
         tiny = random_patches(rng, 6, spread=1.0)
         tiny[..., :3] *= scale
@@ -206,11 +211,11 @@ def test_row_lanes_are_the_rows_point_by_point(tessellator, rng):
     factors = random_factors(rng, count, high=64)
     whole = rng.random(count) < 0.5  # uniform rows of every length from 1 to 63 points
     factors[whole] = (np.arange(count) % 64 + 1)[whole, None]
-    factors[-20:] = 16
+    factors[-26:] = 16
     with_lanes = lanes_vertices(pocl, patches, factors, 1)
-    alone = lanes_vertices(pocl, patches, factors, 0)
+    one_by_one = lanes_vertices(pocl, patches, factors, 0)
     for name in with_lanes:
-        differ = with_lanes[name].view(np.uint32) != alone[name].view(np.uint32)
+        differ = with_lanes[name].view(np.uint32) != one_by_one[name].view(np.uint32)
         assert not differ.any(), f"{name}: {differ.any(axis=-1).sum() if differ.ndim > 1 else differ.sum()} differ"
     normals = with_lanes["normals"]
     assert (np.abs(normals - [0.0, 0.0, 1.0]).max(axis=1) == 0).sum() > 100  # the flat patches' +z

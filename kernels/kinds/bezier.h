@@ -273,87 +273,126 @@ ALWAYS_INLINE void kind_row_next(__private const kind_patch *patch, __private ki
     *normal = surface_normal(patch->t, x.x, x.y, value, p, row->s_u[0], row->s_v[0]);
 }
 
-#if CLTESS_ROW_LANES
-/* Where CLTESS_ROW_LANES (common.h: PoCL on x86-64), a row's points KIND_ROW_LANES at a time (stages/rows.h
- * put_rows).  The differences are stepped point by point as kind_row_next does; the lanes are the
- * row's last KIND_ROW_LANES points stepped so far (a row's last call steps fewer, and its lanes
- * overlap the call before: the same points, the same bits).  Their positions and normals are made
- * with float8 arithmetic, component by component the same operations in the same order as
- * projected, tangent_cross and unit_or (FP_CONTRACT is off: common.h), so the same bits.  Two
- * shortcuts of those give the same bits without their branch: h.xyz / h.w where h.w is 1 is h.xyz
- * (projected's comment), and a zero component divided by len > 0 is itself (unit_or's).  A lane
- * whose t_u x t_v is (nearly) vanishing, or whose dot(n, n) takes length's rescaling branches
- * (below FLT_MIN, or infinite), gets its normal from surface_normal alone (kind_row_lane). */
-#define KIND_ROW_LANES 8
-typedef struct {
-    float4 s[KIND_ROW_LANES], s_u[KIND_ROW_LANES], s_v[KIND_ROW_LANES];  /* B, B_u, B_v of each lane's point */
-    float8 position[3], normal[3];  /* by component, a lane a point */
-    int8 plain;  /* zero: the lane's normal by surface_normal (its fall-backs) */
-} kind_row_lanes;
+#if CLTESS_LANES
+/* Where CLTESS_LANES (common.h: PoCL on x86-64), stage 4 makes KIND_LANES points at once
+ * (stages/rows.h): a row's points (forward differencing) and a ring edge's normals (kind_eval).
+ * Each lane is computed with float8 arithmetic, component by component the same operations in
+ * the same order as the scalar functions (FP_CONTRACT is off: common.h), so the same bits.  Two
+ * shortcuts of projected and unit_or give the same bits without their branch: h.xyz / h.w where
+ * h.w is 1 is h.xyz (projected's comment), and a zero component divided by len > 0 is itself
+ * (unit_or's).  A lane whose t_u x t_v is (nearly) vanishing, or whose dot(n, n) takes length's
+ * rescaling branches (below FLT_MIN, or infinite), is not "plain": stages/rows.h then makes the
+ * eight points one by one by the scalar functions (put_row_lanes, put_ring_lanes).  The kind's
+ * side of the contract: KIND_LANES, kind_row_next_lanes, kind_row_skip, kind_eval_lanes
+ * (docs/extending.md). */
+#define KIND_LANES 8
 
-/* Step `count` (1 .. KIND_ROW_LANES) more points of the row into the lanes; a count below
- * KIND_ROW_LANES keeps the earlier lanes' last points in front of them. */
-ALWAYS_INLINE void kind_row_next_lanes(__private const kind_patch *patch, __private kind_row *row, int count,
-                                       __private kind_row_lanes *lanes)
+/* bernstein3 / bernstein2 of eight lanes. */
+ALWAYS_INLINE void bernstein3_lanes(float8 t, float8 b[4])
 {
-    if (count == KIND_ROW_LANES) {
-        __attribute__((opencl_unroll_hint))
-        for (int k = 0; k < KIND_ROW_LANES; ++k) {
-            step_differences(row->s);
-            step_differences(row->s_u);
-            step_differences(row->s_v);
-            lanes->s[k] = row->s[0];
-            lanes->s_u[k] = row->s_u[0];
-            lanes->s_v[k] = row->s_v[0];
+    float8 s = 1.0f - t;
+    b[0] = s * s * s;
+    b[1] = 3.0f * t * s * s;
+    b[2] = 3.0f * t * t * s;
+    b[3] = t * t * t;
+}
+
+ALWAYS_INLINE void bernstein2_lanes(float8 t, float8 b[3])
+{
+    float8 s = 1.0f - t;
+    b[0] = s * s;
+    b[1] = 2.0f * t * s;
+    b[2] = t * t;
+}
+
+/* surface_eval at eight points (u, v): B, B_u, B_v by component (s[c] is component c's lanes). */
+ALWAYS_INLINE void surface_eval_lanes(const float4 b[16], float8 u, float8 v, float8 s[4], float8 s_u[4],
+                                      float8 s_v[4])
+{
+    float8 bv[4], dv[3], bu[4], du[3];
+    bernstein3_lanes(v, bv);
+    bernstein2_lanes(v, dv);
+    bernstein3_lanes(u, bu);
+    bernstein2_lanes(u, du);
+    for (int k = 0; k < 4; ++k) {  /* row_controls, then the point, component k */
+        float8 c[4], d[4];
+        for (int i = 0; i < 4; ++i) {
+            c[i] = bv[0] * b[i][k] + bv[1] * b[4 + i][k] + bv[2] * b[8 + i][k] + bv[3] * b[12 + i][k];
+            d[i] = 3.0f * (dv[0] * (b[4 + i][k] - b[i][k]) + dv[1] * (b[8 + i][k] - b[4 + i][k])
+                           + dv[2] * (b[12 + i][k] - b[8 + i][k]));
         }
-    } else {
-        int kept = KIND_ROW_LANES - count;
-        for (int k = 0; k < kept; ++k) {
-            lanes->s[k] = lanes->s[k + count];
-            lanes->s_u[k] = lanes->s_u[k + count];
-            lanes->s_v[k] = lanes->s_v[k + count];
-        }
-        for (int k = kept; k < KIND_ROW_LANES; ++k) {
-            step_differences(row->s);
-            step_differences(row->s_u);
-            step_differences(row->s_v);
-            lanes->s[k] = row->s[0];
-            lanes->s_u[k] = row->s_u[0];
-            lanes->s_v[k] = row->s_v[0];
-        }
+        s[k] = bu[0] * c[0] + bu[1] * c[1] + bu[2] * c[2] + bu[3] * c[3];
+        s_u[k] = 3.0f * (du[0] * (c[1] - c[0]) + du[1] * (c[2] - c[1]) + du[2] * (c[3] - c[2]));
+        s_v[k] = bu[0] * d[0] + bu[1] * d[1] + bu[2] * d[2] + bu[3] * d[3];
     }
-    float8 s[4], s_u[4], s_v[4];
-    lanes_of(lanes->s, s);
-    lanes_of(lanes->s_u, s_u);
-    lanes_of(lanes->s_v, s_v);
+}
+
+/* projected(B) into p[3] and surface_normal's plain case into normal[3], at eight points; *plain
+ * nonzero where that case is the one surface_normal takes (tangent_cross's ok, then length3's
+ * plain branch). */
+ALWAYS_INLINE void normal_lanes(const float8 s[4], const float8 s_u[4], const float8 s_v[4], float8 p[3],
+                                float8 normal[3], __private int8 *plain)
+{
     float8 px = s[0] / s[3], py = s[1] / s[3], pz = s[2] / s[3];
-    lanes->position[0] = px + patch->centre.x;
-    lanes->position[1] = py + patch->centre.y;
-    lanes->position[2] = pz + patch->centre.z;
+    p[0] = px;
+    p[1] = py;
+    p[2] = pz;
     float8 tux = s_u[0] - s_u[3] * px, tuy = s_u[1] - s_u[3] * py, tuz = s_u[2] - s_u[3] * pz;
     float8 tvx = s_v[0] - s_v[3] * px, tvy = s_v[1] - s_v[3] * py, tvz = s_v[2] - s_v[3] * pz;
     float8 nx = tuy * tvz - tuz * tvy, ny = tuz * tvx - tux * tvz, nz = tux * tvy - tuy * tvx;  /* cross3 */
     float8 scale = (tux * tux + tuy * tuy + tuz * tuz) + (tvx * tvx + tvy * tvy + tvz * tvz);  /* dot3f */
     float8 nn = nx * nx + ny * ny + nz * nz;
     int8 ok = nn > NORMAL_DEGENERATE * NORMAL_DEGENERATE * scale * scale;  /* tangent_cross */
-    lanes->plain = ok & (nn >= FLT_MIN) & (nn != INFINITY);  /* length3's plain branch */
+    *plain = ok & (nn >= FLT_MIN) & (nn != INFINITY);  /* length3's plain branch */
     float8 len = (float8)(sqrt1f(nn.s0), sqrt1f(nn.s1), sqrt1f(nn.s2), sqrt1f(nn.s3), sqrt1f(nn.s4), sqrt1f(nn.s5),
                           sqrt1f(nn.s6), sqrt1f(nn.s7));  /* one vsqrtps on PoCL, where sqrt(float8) is a call */
-    lanes->normal[0] = nx / len;
-    lanes->normal[1] = ny / len;
-    lanes->normal[2] = nz / len;
+    normal[0] = nx / len;
+    normal[1] = ny / len;
+    normal[2] = nz / len;
 }
 
-/* Lane k's position and normal (x its domain point, for the normal's fall-backs). */
-ALWAYS_INLINE void kind_row_lane(__private const kind_patch *patch, __private const kind_row_lanes *lanes, int k,
-                                 float3 x, __private float3 *position, __private float3 *normal)
+/* kind_eval's normals at eight domain points (u, v); *plain as normal_lanes. */
+ALWAYS_INLINE void kind_eval_lanes(__private const kind_patch *patch, float8 u, float8 v, float8 normal[3],
+                                   __private int8 *plain)
 {
-    *position = (float3)(lanes->position[0][k], lanes->position[1][k], lanes->position[2][k]);
-    if (!lanes->plain[k])
-        *normal = surface_normal(patch->t, x.x, x.y, lanes->s[k], projected(lanes->s[k]), lanes->s_u[k],
-                                 lanes->s_v[k]);
-    else
-        *normal = (float3)(lanes->normal[0][k], lanes->normal[1][k], lanes->normal[2][k]);
+    float8 s[4], s_u[4], s_v[4], p[3];
+    surface_eval_lanes(patch->t, u, v, s, s_u, s_v);
+    normal_lanes(s, s_u, s_v, p, normal, plain);
+}
+
+/* The next KIND_LANES points of a row, stepped as kind_row_next steps them: their positions and
+ * normals by component (a lane a point), *plain as normal_lanes. */
+ALWAYS_INLINE void kind_row_next_lanes(__private const kind_patch *patch, __private kind_row *row, float8 position[3],
+                                       float8 normal[3], __private int8 *plain)
+{
+    float4 value[KIND_LANES], d_u[KIND_LANES], d_v[KIND_LANES];
+    __attribute__((opencl_unroll_hint))
+    for (int k = 0; k < KIND_LANES; ++k) {
+        step_differences(row->s);
+        step_differences(row->s_u);
+        step_differences(row->s_v);
+        value[k] = row->s[0];
+        d_u[k] = row->s_u[0];
+        d_v[k] = row->s_v[0];
+    }
+    float8 s[4], s_u[4], s_v[4], p[3];
+    lanes_of(value, s);
+    lanes_of(d_u, s_u);
+    lanes_of(d_v, s_v);
+    normal_lanes(s, s_u, s_v, p, normal, plain);
+    position[0] = p[0] + patch->centre.x;  /* kind_row_next's p + centre */
+    position[1] = p[1] + patch->centre.y;
+    position[2] = p[2] + patch->centre.z;
+}
+
+/* `count` steps of a row with no point made (the differences as kind_row_next steps them). */
+ALWAYS_INLINE void kind_row_skip(__private kind_row *row, int count)
+{
+    for (int k = 0; k < count; ++k) {
+        step_differences(row->s);
+        step_differences(row->s_u);
+        step_differences(row->s_v);
+    }
 }
 #endif
 

@@ -17,7 +17,63 @@ ALWAYS_INLINE float3 ring_position(__private const kind_patch *patch, int4 f, in
     return kind_boundary_point(patch, e, (collapsed >> e) & 1 ? corner : t);
 }
 
-/* The ring of patch p from output slot at; returns the slot after it. */
+#ifdef KIND_LANES
+/* Ring points first .. first + KIND_LANES - 1 of edge e to output slot at, bitwise what put_ring's
+ * loop writes: their positions by ring_position, their normals by kind_eval_lanes (kinds/bezier.h
+ * on PoCL); where a lane is not plain, the eight one by one as put_ring's loop makes them. */
+ALWAYS_INLINE void put_ring_lanes(__private const kind_patch *patch, int4 f, int collapsed, int e, int first,
+                                  vertex_out out, ulong at, uint p, int object)
+{
+    float3 position[KIND_LANES], x[KIND_LANES];
+    __attribute__((opencl_unroll_hint))
+    for (int k = 0; k < KIND_LANES; ++k)
+        position[k] = ring_position(patch, f, collapsed, e, first + k, &x[k]);
+    float8 domain[3], normal[3], positions[3];
+    int8 plain;
+    lanes_of3(x, domain);
+    kind_eval_lanes(patch, domain[0], domain[1], normal, &plain);
+    if (every_lane(plain)) {
+        lanes_of3(position, positions);
+        put_vertex_lanes(out, at, positions, normal, domain[0], domain[1], p, object);
+        return;
+    }
+    for (int k = 0; k < KIND_LANES; ++k) {
+        float3 alone;
+        kind_eval(patch, x[k], 0, &alone);
+        put_vertex(out, at + k, position[k], alone, x[k].xy, p, object);
+    }
+}
+
+/* Row j's points first .. first + KIND_LANES - 1 to output slot at, from *row stepped to just
+ * before them (kind_row_begin'd, then first - 1 steps), and on past them, bitwise what put_rows'
+ * loop writes: by kind_row_next_lanes, or, where a lane is not plain, one by one by kind_row_next. */
+ALWAYS_INLINE void put_row_lanes(__private const kind_patch *patch, int4 f, int j, int first,
+                                 __private kind_row *row, vertex_out out, ulong at, uint p, int object)
+{
+    kind_row start = *row;
+    float3 x[KIND_LANES];
+    __attribute__((opencl_unroll_hint))
+    for (int k = 0; k < KIND_LANES; ++k)
+        x[k] = pattern_row_point(f, j, first + k);
+    float8 position[3], normal[3], domain[3];
+    int8 plain;
+    kind_row_next_lanes(patch, row, position, normal, &plain);
+    if (every_lane(plain)) {
+        lanes_of3(x, domain);
+        put_vertex_lanes(out, at, position, normal, domain[0], domain[1], p, object);
+        return;
+    }
+    for (int k = 0; k < KIND_LANES; ++k) {
+        float3 alone_position, alone_normal;
+        kind_row_next(patch, &start, x[k], &alone_position, &alone_normal);
+        put_vertex(out, at + k, alone_position, alone_normal, x[k].xy, p, object);
+    }
+}
+#endif
+
+/* The ring of patch p from output slot at; returns the slot after it.  Where the kind has lanes
+ * (KIND_LANES), an edge of at least KIND_LANES points goes by put_ring_lanes, its last lanes
+ * overlapping the ones before (the same points again, the same bits). */
 ALWAYS_INLINE ulong put_ring(__private const kind_patch *patch, int4 f, int collapsed, vertex_out out, ulong at,
                              uint p, int object)
 {
@@ -25,6 +81,16 @@ ALWAYS_INLINE ulong put_ring(__private const kind_patch *patch, int4 f, int coll
     __attribute__((opencl_unroll_hint))  /* e constant in each copy: the edge's data in registers */
     for (int e = 0; e < PATTERN_EDGES; ++e) {
         int ring_count = PATTERN_EDGE_POINTS(f, e);
+#ifdef KIND_LANES
+        if (ring_count >= KIND_LANES) {
+            for (int k = 0; k < ring_count; k += KIND_LANES) {
+                int first = imin(k, ring_count - KIND_LANES);
+                put_ring_lanes(patch, f, collapsed, e, first, out, at + first, p, object);
+            }
+            at += ring_count;
+            continue;
+        }
+#endif
         for (int k = 0; k < ring_count; ++k) {
             float3 position = ring_position(patch, f, collapsed, e, k, &x);
             kind_eval(patch, x, 0, &normal);  /* the normal; the position is the edge's */
@@ -121,33 +187,18 @@ ALWAYS_INLINE void put_rows(__private const kind_patch *patch, int4 f, int colla
         if (forward_differencing) {
             kind_row row;
             kind_row_begin(patch, pattern_row_point(f, j, 0), pattern_row_point(f, j, steps), steps, &row);
-#if defined(KIND_ROW_LANES) && !PATTERN_CHORD_POINTS  /* KIND_ROW_LANES points at once (kinds/bezier.h on PoCL) */
-            if (steps - 1 >= KIND_ROW_LANES) {
-                kind_row_lanes lanes;
-                for (int i = 1; i < steps;) {
-                    int count = imin(KIND_ROW_LANES, steps - i);
-                    kind_row_next_lanes(patch, &row, count, &lanes);
-                    i += count;
-                    at += count;
-                    ulong first = at - KIND_ROW_LANES;  /* the lanes: the row's points i - 8 .. i - 1 */
-                    if (every_lane(lanes.plain)) {
-                        float u[KIND_ROW_LANES], v[KIND_ROW_LANES];
-                        __attribute__((opencl_unroll_hint))
-                        for (int k = 0; k < KIND_ROW_LANES; ++k) {
-                            float3 x = pattern_row_point(f, j, i - KIND_ROW_LANES + k);
-                            u[k] = x.x;
-                            v[k] = x.y;
-                        }
-                        put_vertex_lanes(out, first, lanes.position, lanes.normal, *(float8 *)u, *(float8 *)v, p,
-                                         object);
-                        continue;
-                    }
-                    for (int k = 0; k < KIND_ROW_LANES; ++k) {
-                        float3 x = pattern_row_point(f, j, i - KIND_ROW_LANES + k);
-                        kind_row_lane(patch, &lanes, k, x, &position, &normal);
-                        put_vertex(out, first + k, position, normal, x.xy, p, object);
-                    }
+#if defined(KIND_LANES) && !PATTERN_CHORD_POINTS
+            if (steps - 1 >= KIND_LANES) {  /* KIND_LANES points at once (kinds/bezier.h on PoCL) */
+                kind_row start = row;
+                int i = 1;
+                for (; i + KIND_LANES <= steps; i += KIND_LANES)
+                    put_row_lanes(patch, f, j, i, &row, out, at + (i - 1), p, object);
+                if (i < steps) {  /* the last KIND_LANES points, overlapping the ones before: stepped again */
+                    kind_row_skip(&start, steps - 1 - KIND_LANES);
+                    put_row_lanes(patch, f, j, steps - KIND_LANES, &start, out, at + (steps - 1 - KIND_LANES), p,
+                                  object);
                 }
+                at += steps - 1;
                 continue;
             }
 #endif

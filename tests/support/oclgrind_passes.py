@@ -26,7 +26,7 @@ import oclgrind_scenarios as scenarios
 RUNNER = Path(scenarios.__file__).resolve()
 NAMES = [*scenarios.SCENARIOS, *scenarios.BATCHED, *scenarios.BY_LEVEL, *scenarios.ROWS_IN_PARALLEL, *scenarios.POINTS,
          *scenarios.SILHOUETTE, *scenarios.FUSED_OFFSETS, *scenarios.TILED_OFFSETS, *scenarios.FRAMES,
-         *scenarios.FUSED_CRACK_FREE, *scenarios.ROW_LANES]
+         *scenarios.FUSED_CRACK_FREE, *scenarios.LANES]
 
 PASSES = {
     "checks": dict(env=scenarios.OCLGRIND_ENV, args=[],
