@@ -127,10 +127,57 @@ ALWAYS_INLINE int imax(int a, int b) { return a < b ? b : a; }
  * (Oclgrind's scenarios: tests/oclgrind_scenarios.py LANES), =0 turns it off.  The lanes are written without vload8, vstore8, shuffle, sqrt(float8) and all, which PoCL
  * keeps out of line; the unaligned vector type is Clang's extension, which every runtime here
  * builds with. */
+/* Intel's CPU runtime (2026.2 defines cl_intel_vec_len_hint, its vectoriser's hint, as a macro). */
+#if defined(cl_intel_vec_len_hint) && !defined(CLTESS_BUILTIN_FORMS)
+#define CLTESS_INTEL_FORMS 1
+#else
+#define CLTESS_INTEL_FORMS 0
+#endif
 #ifndef CLTESS_LANES
-#define CLTESS_LANES CLTESS_POCL_FORMS
+#define CLTESS_LANES (CLTESS_POCL_FORMS || CLTESS_INTEL_FORMS)
 #endif
 #if CLTESS_LANES
+/* The builtins that stage 4's normals use, over eight lanes, as each runtime computes them, so
+ * that every lane is bitwise the scalar builtin (tests/test_unit_normal.py checks them against
+ * the builtins, special values included).  Intel's CPU runtime (its scalar code, 2026.2:
+ * bench/kernels/cpu_stage4_probe.cl, session 4) computes cross and length in double (products
+ * of floats are exact there, then one rounding) and dot by dpps, (p0 + p1) + (p2 + +0); PoCL's
+ * are those spelled out above.  lanes_length_plain: where length's value is the plain one that
+ * lanes_length gives (PoCL's length takes scaled branches below FLT_MIN and at infinity). */
+#if CLTESS_INTEL_FORMS
+#pragma OPENCL EXTENSION cl_khr_fp64 : enable
+ALWAYS_INLINE float8 lanes_dot(float8 ax, float8 ay, float8 az, float8 bx, float8 by, float8 bz)
+{
+    return (ax * bx + ay * by) + (az * bz + 0.0f);
+}
+ALWAYS_INLINE float8 lanes_cross_term(float8 a1, float8 b2, float8 a2, float8 b1)  /* a1 b2 - a2 b1 */
+{
+    return convert_float8(convert_double8(a1) * convert_double8(b2) - convert_double8(a2) * convert_double8(b1));
+}
+ALWAYS_INLINE float8 lanes_length(float8 x, float8 y, float8 z)
+{
+    double8 dx = convert_double8(x), dy = convert_double8(y), dz = convert_double8(z);
+    return convert_float8(sqrt((dx * dx + dy * dy) + dz * dz));
+}
+ALWAYS_INLINE int8 lanes_length_plain(float8 x, float8 y, float8 z) { return (int8)(-1); }  /* no branches */
+#else
+ALWAYS_INLINE float8 lanes_dot(float8 ax, float8 ay, float8 az, float8 bx, float8 by, float8 bz)
+{
+    return ax * bx + ay * by + az * bz;  /* dot3 */
+}
+ALWAYS_INLINE float8 lanes_cross_term(float8 a1, float8 b2, float8 a2, float8 b1) { return a1 * b2 - a2 * b1; }
+ALWAYS_INLINE float8 lanes_length(float8 x, float8 y, float8 z)
+{
+    float8 s = lanes_dot(x, y, z, x, y, z);
+    return (float8)(sqrt1f(s.s0), sqrt1f(s.s1), sqrt1f(s.s2), sqrt1f(s.s3), sqrt1f(s.s4), sqrt1f(s.s5),
+                    sqrt1f(s.s6), sqrt1f(s.s7));  /* one vsqrtps on PoCL, where sqrt(float8) is a call */
+}
+ALWAYS_INLINE int8 lanes_length_plain(float8 x, float8 y, float8 z)
+{
+    float8 s = lanes_dot(x, y, z, x, y, z);
+    return (s >= FLT_MIN) & (s != INFINITY);
+}
+#endif
 /* Vectors of 8 that may sit at any float or int (vmovups). */
 typedef float float8_at_float __attribute__((ext_vector_type(8), aligned(4)));
 typedef int int8_at_int __attribute__((ext_vector_type(8), aligned(4)));

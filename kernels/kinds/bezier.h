@@ -339,13 +339,13 @@ ALWAYS_INLINE void normal_lanes(const float8 s[4], const float8 s_u[4], const fl
     p[2] = pz;
     float8 tux = s_u[0] - s_u[3] * px, tuy = s_u[1] - s_u[3] * py, tuz = s_u[2] - s_u[3] * pz;
     float8 tvx = s_v[0] - s_v[3] * px, tvy = s_v[1] - s_v[3] * py, tvz = s_v[2] - s_v[3] * pz;
-    float8 nx = tuy * tvz - tuz * tvy, ny = tuz * tvx - tux * tvz, nz = tux * tvy - tuy * tvx;  /* cross3 */
-    float8 scale = (tux * tux + tuy * tuy + tuz * tuz) + (tvx * tvx + tvy * tvy + tvz * tvz);  /* dot3f */
-    float8 nn = nx * nx + ny * ny + nz * nz;
+    float8 nx = lanes_cross_term(tuy, tvz, tuz, tvy), ny = lanes_cross_term(tuz, tvx, tux, tvz),
+           nz = lanes_cross_term(tux, tvy, tuy, tvx);  /* cross3 */
+    float8 scale = lanes_dot(tux, tuy, tuz, tux, tuy, tuz) + lanes_dot(tvx, tvy, tvz, tvx, tvy, tvz);
+    float8 nn = lanes_dot(nx, ny, nz, nx, ny, nz);
     int8 ok = nn > NORMAL_DEGENERATE * NORMAL_DEGENERATE * scale * scale;  /* tangent_cross */
-    *plain = ok & (nn >= FLT_MIN) & (nn != INFINITY);  /* length3's plain branch */
-    float8 len = (float8)(sqrt1f(nn.s0), sqrt1f(nn.s1), sqrt1f(nn.s2), sqrt1f(nn.s3), sqrt1f(nn.s4), sqrt1f(nn.s5),
-                          sqrt1f(nn.s6), sqrt1f(nn.s7));  /* one vsqrtps on PoCL, where sqrt(float8) is a call */
+    float8 len = lanes_length(nx, ny, nz);  /* normal_length */
+    *plain = ok & lanes_length_plain(nx, ny, nz) & (len > 0.0f);  /* unit_or's quotients */
     normal[0] = nx / len;
     normal[1] = ny / len;
     normal[2] = nz / len;
