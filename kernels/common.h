@@ -122,11 +122,12 @@ ALWAYS_INLINE int imax(int a, int b) { return a < b ? b : a; }
 
 /* --- eight lanes (issue 15, the CPU line) -----------------------------------------------------
  * Stage 4's rows and ring edges KIND_LANES points at once (stages/rows.h, kinds/bezier.h): by
- * default on PoCL for x86-64, where the per-patch stage 4 of uniform level 16 takes 0.63x the
- * CPU time (bench/RESULTS.md, "Session 13, lead"); -D CLTESS_LANES=1 forces it anywhere
- * (Oclgrind's scenarios: tests/oclgrind_scenarios.py LANES), =0 turns it off.  The lanes are written without vload8, vstore8, shuffle, sqrt(float8) and all, which PoCL
- * keeps out of line; the unaligned vector type is Clang's extension, which every runtime here
- * builds with. */
+ * default on the two CPU runtimes cltess installs, Intel's and PoCL (x86-64), where the
+ * per-patch stage 4 of uniform level 16 takes 0.6x the CPU time (bench/RESULTS.md, "Session 13,
+ * lead"); -D CLTESS_LANES=1 forces it anywhere (Oclgrind's scenarios: tests/oclgrind_scenarios.py
+ * LANES), =0 turns it off.  The lanes are written without vload8, vstore8, shuffle, sqrt(float8)
+ * and all, which PoCL keeps out of line; the unaligned vector type is Clang's extension, which
+ * every runtime here builds with. */
 /* Intel's CPU runtime (2026.2 defines cl_intel_vec_len_hint, its vectoriser's hint, as a macro). */
 #if defined(cl_intel_vec_len_hint) && !defined(CLTESS_BUILTIN_FORMS)
 #define CLTESS_INTEL_FORMS 1

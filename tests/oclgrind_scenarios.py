@@ -467,7 +467,7 @@ UNINITIALIZED_SKIPPED = {
 }
 
 #: Scenarios whose stage 4 makes a row's or a ring edge's points eight at a time (kernels/common.h
-#: CLTESS_LANES, PoCL's default on x86-64, forced here: -D CLTESS_LANES=1), on rows and edges of 9
+#: CLTESS_LANES, the CPU runtimes' default, forced here: -D CLTESS_LANES=1), on rows and edges of 9
 #: to 24 points (the last eight overlap the eight before), the rational sphere's with its
 #: collapsed poles: the base scenario and options to change.
 LANES = {"uniform_fine_by_lanes": ("uniform_fine", {}),

@@ -274,17 +274,18 @@ ALWAYS_INLINE void kind_row_next(__private const kind_patch *patch, __private ki
 }
 
 #if CLTESS_LANES
-/* Where CLTESS_LANES (common.h: PoCL on x86-64), stage 4 makes KIND_LANES points at once
- * (stages/rows.h): a row's points (forward differencing) and a ring edge's normals (kind_eval).
- * Each lane is computed with float8 arithmetic, component by component the same operations in
- * the same order as the scalar functions (FP_CONTRACT is off: common.h), so the same bits.  Two
- * shortcuts of projected and unit_or give the same bits without their branch: h.xyz / h.w where
- * h.w is 1 is h.xyz (projected's comment), and a zero component divided by len > 0 is itself
- * (unit_or's).  A lane whose t_u x t_v is (nearly) vanishing, or whose dot(n, n) takes length's
- * rescaling branches (below FLT_MIN, or infinite), is not "plain": stages/rows.h then makes the
- * eight points one by one by the scalar functions (put_row_lanes, put_ring_lanes).  The kind's
- * side of the contract: KIND_LANES, kind_row_next_lanes, kind_row_skip, kind_eval_lanes
- * (docs/extending.md). */
+/* Where CLTESS_LANES (common.h: Intel's CPU runtime, PoCL on x86-64), stage 4 makes KIND_LANES
+ * points at once (stages/rows.h): a row's points (forward differencing) and a ring edge's normals
+ * (kind_eval).  Each lane is computed with float8 arithmetic, component by component the same
+ * operations in the same order as the scalar functions (FP_CONTRACT is off: common.h), and the
+ * builtins in the runtime's own forms (common.h lanes_cross_term, lanes_dot, lanes_length), so
+ * the same bits.  Two shortcuts of projected and unit_or give the same bits without their branch:
+ * h.xyz / h.w where h.w is 1 is h.xyz (projected's comment), and a zero component divided by
+ * len > 0 is itself (unit_or's).  A lane whose t_u x t_v is (nearly) vanishing, or whose length
+ * is not its plain value (lanes_length_plain: PoCL's scaled branches) or not positive, is not
+ * "plain": stages/rows.h then makes the eight points one by one by the scalar functions
+ * (put_row_lanes, put_ring_lanes).  The kind's side of the contract: KIND_LANES,
+ * kind_row_next_lanes, kind_row_skip, kind_eval_lanes (docs/extending.md). */
 #define KIND_LANES 8
 
 /* bernstein3 / bernstein2 of eight lanes. */
@@ -328,8 +329,8 @@ ALWAYS_INLINE void surface_eval_lanes(const float4 b[16], float8 u, float8 v, fl
 }
 
 /* projected(B) into p[3] and surface_normal's plain case into normal[3], at eight points; *plain
- * nonzero where that case is the one surface_normal takes (tangent_cross's ok, then length3's
- * plain branch). */
+ * nonzero where that case is the one surface_normal takes (tangent_cross's ok, then
+ * normal_length's plain value, and positive, so that unit_or divides). */
 ALWAYS_INLINE void normal_lanes(const float8 s[4], const float8 s_u[4], const float8 s_v[4], float8 p[3],
                                 float8 normal[3], __private int8 *plain)
 {
@@ -362,8 +363,8 @@ ALWAYS_INLINE void kind_eval_lanes(__private const kind_patch *patch, float8 u, 
 
 /* The next KIND_LANES points of a row, stepped as kind_row_next steps them: their positions and
  * normals by component (a lane a point), *plain as normal_lanes. */
-ALWAYS_INLINE void kind_row_next_lanes(__private const kind_patch *patch, __private kind_row *row, float8 position[3],
-                                       float8 normal[3], __private int8 *plain)
+ALWAYS_INLINE void kind_row_next_lanes(__private const kind_patch *patch, __private kind_row *row,
+                                       float8 position[3], float8 normal[3], __private int8 *plain)
 {
     float4 value[KIND_LANES], d_u[KIND_LANES], d_v[KIND_LANES];
     __attribute__((opencl_unroll_hint))
