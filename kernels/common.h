@@ -26,22 +26,27 @@
 
 /* --- Bernstein bases and power form ---------------------------------------------------------- */
 
-inline void bernstein3(float t, float b[4])
-{
-    float s = 1.0f - t;
-    b[0] = s * s * s;
-    b[1] = 3.0f * t * s * s;
-    b[2] = 3.0f * t * t * s;
-    b[3] = t * t * t;
-}
+/* Written once for float and for float8 lanes (kinds/bezier.h bernstein3_lanes): a lane must do
+ * the same operations in the same order. */
+#define BERNSTEIN3_OF(T)                                                                             \
+    {                                                                                                \
+        T s = 1.0f - t;                                                                              \
+        b[0] = s * s * s;                                                                            \
+        b[1] = 3.0f * t * s * s;                                                                     \
+        b[2] = 3.0f * t * t * s;                                                                     \
+        b[3] = t * t * t;                                                                            \
+    }
+#define BERNSTEIN2_OF(T)                                                                             \
+    {                                                                                                \
+        T s = 1.0f - t;                                                                              \
+        b[0] = s * s;                                                                                \
+        b[1] = 2.0f * t * s;                                                                         \
+        b[2] = t * t;                                                                                \
+    }
 
-inline void bernstein2(float t, float b[3])
-{
-    float s = 1.0f - t;
-    b[0] = s * s;
-    b[1] = 2.0f * t * s;
-    b[2] = t * t;
-}
+inline void bernstein3(float t, float b[4]) BERNSTEIN3_OF(float)
+
+inline void bernstein2(float t, float b[3]) BERNSTEIN2_OF(float)
 
 inline float4 lerp4(float4 a, float4 b, float t) { return a + t * (b - a); }
 

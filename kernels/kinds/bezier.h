@@ -288,23 +288,10 @@ ALWAYS_INLINE void kind_row_next(__private const kind_patch *patch, __private ki
  * kind_row_next_lanes, kind_row_skip, kind_eval_lanes (docs/extending.md). */
 #define KIND_LANES 8
 
-/* bernstein3 / bernstein2 of eight lanes. */
-ALWAYS_INLINE void bernstein3_lanes(float8 t, float8 b[4])
-{
-    float8 s = 1.0f - t;
-    b[0] = s * s * s;
-    b[1] = 3.0f * t * s * s;
-    b[2] = 3.0f * t * t * s;
-    b[3] = t * t * t;
-}
+/* bernstein3 / bernstein2 of eight lanes (common.h: the same body). */
+ALWAYS_INLINE void bernstein3_lanes(float8 t, float8 b[4]) BERNSTEIN3_OF(float8)
 
-ALWAYS_INLINE void bernstein2_lanes(float8 t, float8 b[3])
-{
-    float8 s = 1.0f - t;
-    b[0] = s * s;
-    b[1] = 2.0f * t * s;
-    b[2] = t * t;
-}
+ALWAYS_INLINE void bernstein2_lanes(float8 t, float8 b[3]) BERNSTEIN2_OF(float8)
 
 /* surface_eval at eight points (u, v): B, B_u, B_v by component (s[c] is component c's lanes). */
 ALWAYS_INLINE void surface_eval_lanes(const float4 b[16], float8 u, float8 v, float8 s[4], float8 s_u[4],
