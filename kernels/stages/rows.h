@@ -20,7 +20,8 @@ ALWAYS_INLINE float3 ring_position(__private const kind_patch *patch, int4 f, in
 #ifdef KIND_LANES
 /* Ring points first .. first + KIND_LANES - 1 of edge e to output slot at, bitwise what put_ring's
  * loop writes: their positions by ring_position, their normals by kind_eval_lanes (kinds/bezier.h
- * on PoCL); where a lane is not plain, the eight one by one as put_ring's loop makes them. */
+ * on the CPU runtimes); where a lane is not plain, the eight one by one as put_ring's loop makes
+ * them. */
 ALWAYS_INLINE void put_ring_lanes(__private const kind_patch *patch, int4 f, int collapsed, int e, int first,
                                   vertex_out out, ulong at, uint p, int object)
 {
@@ -188,7 +189,7 @@ ALWAYS_INLINE void put_rows(__private const kind_patch *patch, int4 f, int colla
             kind_row row;
             kind_row_begin(patch, pattern_row_point(f, j, 0), pattern_row_point(f, j, steps), steps, &row);
 #if defined(KIND_LANES) && !PATTERN_CHORD_POINTS
-            if (steps - 1 >= KIND_LANES) {  /* KIND_LANES points at once (kinds/bezier.h on PoCL) */
+            if (steps - 1 >= KIND_LANES) {  /* KIND_LANES points at once (kinds/bezier.h, CPU runtimes) */
                 kind_row start = row;
                 int i = 1;
                 for (; i + KIND_LANES <= steps; i += KIND_LANES)
