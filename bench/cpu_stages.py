@@ -95,8 +95,9 @@ def timed(launch, repeat: int) -> dict:
 
 def build(context, device, folder: Path, stage_source: str, stage: str, pattern, defines=(), kind=BEZIER) -> cl.Program:
     headers, _ = composition(stage, kind=kind, pattern=pattern)
-    source = "".join(f'#include "{header}"\n' for header in ("common.h", *headers))
-    source += "".join(f"#define {d}\n" for d in defines) + stage_source
+    # NAME or NAME=VALUE, before the headers so that they see them too
+    source = "".join(f"#define {d.replace('=', ' ', 1)}\n" for d in defines)
+    source += "".join(f'#include "{header}"\n' for header in ("common.h", *headers)) + stage_source
     options = ["-I", str(folder)] + correctly_rounded_division(device)
     return cl.Program(context, source).build(options=options)
 

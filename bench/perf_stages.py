@@ -8,7 +8,8 @@ instruction.
 
 Uniform level 16 as ``bench/cpu_stages.py`` (``--copies`` teapots of 32 patches, every edge factor
 16; or ``--scene``: a suite scene of one kind at ``--pixels``, e.g. the PN triangles of model_zoo), stages 1-3 planned once by the engine; then the named stage's per-patch kernel, built like
-cpu_stages.py does (from ``--kernels``, default this tree's kernels/, with ``-D`` ``--define``s),
+cpu_stages.py does (from ``--kernels``, default this tree's kernels/, with ``--define`` NAME or NAME=VALUE
+before its headers),
 is launched ``--launches`` times, each waited, after ``--warm`` launches that are not timed
 (``--local``: with that work-group size; by default none, so the runtime picks: PoCL took 4,000
 here, where the engine names 64 on PoCL, programs.py ``names_local_size``).
