@@ -471,7 +471,7 @@ UNINITIALIZED_SKIPPED = {
 #: to 24 points (the last eight overlap the eight before), the rational sphere's with its
 #: collapsed poles: the base scenario and options to change.
 LANES = {"uniform_fine_by_lanes": ("uniform_fine", {}),
-             "rational_sphere_by_lanes": ("rational_sphere", {"eps": 0.001, "max_factor": 12})}
+         "rational_sphere_by_lanes": ("rational_sphere", {"eps": 0.001, "max_factor": 12})}
 
 #: Scenarios whose stage 4 runs a work-item per (patch, row) (stages/vertex_rows.cl), with 3
 #: work-items per patch so that the last one does the remaining rows too.

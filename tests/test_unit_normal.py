@@ -208,11 +208,11 @@ __kernel void lanes(__global const float4 *a, __global const float4 *b, __global
 def test_lane_forms_are_the_builtins(tessellator):
     """Stage 4's lanes (kernels/common.h CLTESS_LANES: on by default on PoCL for x86-64 and on
     Intel's CPU runtime) compute cross, dot and length as that runtime's builtins do: bit for bit
-    (a NaN's sign aside) on 20,000 pairs with signed zeros, infinities, NaNs, subnormals and values whose squares
-    overflow or underflow, length wherever lanes_length_plain says its value is the plain one
-    (elsewhere the lanes leave the point to the scalar code).  On PoCL x86-64 and Intel's CPU
-    runtime the lanes must be on; on other devices, where they are off, the test has nothing to
-    compare."""
+    (a NaN's sign aside) on 20,000 pairs with signed zeros, infinities, NaNs, subnormals and
+    values whose squares overflow or underflow, length wherever lanes_length_plain says its value
+    is the plain one (elsewhere the lanes leave the point to the scalar code).  On PoCL x86-64
+    and Intel's CPU runtime the lanes must be on; on other devices, where they are off, the test
+    has nothing to compare."""
     count = 20000
     a, b = vectors(count, seed=36), vectors(count, seed=37)
     lanes, builtin, flags = np.zeros((count, 6), np.float32), np.empty((count, 6), np.float32), np.zeros(1, np.int32)

@@ -181,21 +181,21 @@ def folded_patch() -> np.ndarray:
 @pytest.mark.parametrize("runtime", ["Portable Computing Language", "Intel(R) OpenCL"], ids=["pocl", "intel"])
 def test_lanes_are_the_points_one_by_one(rng, runtime):
     """Stage 4's interior rows and ring edges KIND_LANES points at once (stages/rows.h,
-    kinds/bezier.h: on by default on PoCL for x86-64 and on Intel's CPU runtime) write bitwise what one point at a time
-    writes, at every row and edge length around the lanes (7 points: no lanes; 8: one set; 9 ..
-    15: the last set overlaps the one before; 16 .. 63; transition patterns' edges of other
-    lengths), with the lanes that take surface_normal's fall-backs: a patch folded so that t_u x
-    t_v vanishes along a line (some lanes of a row, not the others), a patch flat on a line (every
-    lane), patches with a collapsed edge, and squared normals below FLT_MIN (coordinates of 1e-10)
-    or infinite (1e10) where t_u x t_v does not vanish against the tangents: length's scaled
-    branches.  The lanes compute the builtins in the forms of the runtimes where they are the
-    default (common.h: PoCL on x86-64, Intel's CPU runtime), so this runs on those two."""
+    kinds/bezier.h: on by default on PoCL for x86-64 and on Intel's CPU runtime) write bitwise
+    what one point at a time writes, at every row and edge length around the lanes (7 points: no
+    lanes; 8: one set; 9 .. 15: the last set overlaps the one before; 16 .. 63; transition
+    patterns' edges of other lengths), with the lanes that take surface_normal's fall-backs: a
+    patch folded so that t_u x t_v vanishes along a line (some lanes of a row, not the others), a
+    patch flat on a line (every lane), patches with a collapsed edge, and squared normals below
+    FLT_MIN (coordinates of 1e-10) or infinite (1e10) where t_u x t_v does not vanish against the
+    tangents: length's scaled branches.  The lanes compute the builtins in the forms of the
+    runtimes where they are the default (common.h), so this runs on those two."""
     from cltess.pipeline import Tessellator
     try:
-        device = Tessellator(runtime)
+        engine = Tessellator(runtime)
     except Exception as error:  # noqa: BLE001  (not installed here)
         pytest.skip(f"no {runtime} device: {error}")
-    if runtime.startswith("Portable") and "x86_64" not in device.device.version:
+    if runtime.startswith("Portable") and "x86_64" not in engine.device.version:
         pytest.skip("PoCL's lanes are its forms on x86-64")
     patches = [random_patches(rng, 120, spread=1.0)]
     patches.append(np.stack([folded_patch()] * 8))
@@ -204,17 +204,17 @@ def test_lanes_are_the_points_one_by_one(rng, runtime):
     collapsed[:, 0] = collapsed[:, 0, :1]  # edge 0 (v = 0) one point, as the teapot's lid
     patches.append(collapsed)
     for scale in (1e-10, 1e10):
-        tiny = random_patches(rng, 6, spread=1.0)
-        tiny[..., :3] *= scale
-        patches.append(tiny)
+        scaled = random_patches(rng, 6, spread=1.0)
+        scaled[..., :3] *= scale
+        patches.append(scaled)
     patches = np.concatenate(patches)
     count = len(patches)
     factors = random_factors(rng, count, high=64)
     whole = rng.random(count) < 0.5  # uniform rows of every length from 1 to 63 points
     factors[whole] = (np.arange(count) % 64 + 1)[whole, None]
     factors[-26:] = 16
-    with_lanes = lanes_vertices(device, patches, factors, 1)
-    one_by_one = lanes_vertices(device, patches, factors, 0)
+    with_lanes = lanes_vertices(engine, patches, factors, 1)
+    one_by_one = lanes_vertices(engine, patches, factors, 0)
     for name in with_lanes:
         differ = with_lanes[name].view(np.uint32) != one_by_one[name].view(np.uint32)
         assert not differ.any(), f"{name}: {differ.any(axis=-1).sum() if differ.ndim > 1 else differ.sum()} differ"
