@@ -148,8 +148,9 @@ ALWAYS_INLINE int imax(int a, int b) { return a < b ? b : a; }
  * the builtins, special values included).  Intel's CPU runtime (its scalar code, 2026.2:
  * bench/kernels/cpu_stage4_probe.cl, session 4) computes cross and length in double (products
  * of floats are exact there, then one rounding) and dot by dpps, (p0 + p1) + (p2 + +0); PoCL's
- * are those spelled out above.  lanes_length_plain: where length's value is the plain one that
- * lanes_length gives (PoCL's length takes scaled branches below FLT_MIN and at infinity). */
+ * are those spelled out above.  lanes_length_plain(squared), squared the lanes_dot of the vector
+ * with itself: where length's value is the plain one that lanes_length gives (PoCL's length
+ * takes scaled branches below FLT_MIN and at infinity). */
 #if CLTESS_INTEL_FORMS
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 ALWAYS_INLINE float8 lanes_dot(float8 ax, float8 ay, float8 az, float8 bx, float8 by, float8 bz)
@@ -165,7 +166,7 @@ ALWAYS_INLINE float8 lanes_length(float8 x, float8 y, float8 z)
     double8 dx = convert_double8(x), dy = convert_double8(y), dz = convert_double8(z);
     return convert_float8(sqrt((dx * dx + dy * dy) + dz * dz));
 }
-ALWAYS_INLINE int8 lanes_length_plain(float8 x, float8 y, float8 z) { return (int8)(-1); }  /* no branches */
+ALWAYS_INLINE int8 lanes_length_plain(float8 squared) { return (int8)(-1); }  /* no branches */
 #else
 ALWAYS_INLINE float8 lanes_dot(float8 ax, float8 ay, float8 az, float8 bx, float8 by, float8 bz)
 {
@@ -178,11 +179,7 @@ ALWAYS_INLINE float8 lanes_length(float8 x, float8 y, float8 z)
     return (float8)(sqrt1f(s.s0), sqrt1f(s.s1), sqrt1f(s.s2), sqrt1f(s.s3), sqrt1f(s.s4), sqrt1f(s.s5),
                     sqrt1f(s.s6), sqrt1f(s.s7));  /* one vsqrtps on PoCL, where sqrt(float8) is a call */
 }
-ALWAYS_INLINE int8 lanes_length_plain(float8 x, float8 y, float8 z)
-{
-    float8 s = lanes_dot(x, y, z, x, y, z);
-    return (s >= FLT_MIN) & (s != INFINITY);
-}
+ALWAYS_INLINE int8 lanes_length_plain(float8 squared) { return (squared >= FLT_MIN) & (squared != INFINITY); }
 #endif
 /* Vectors of 8 that may sit at any float or int (vmovups). */
 typedef float float8_at_float __attribute__((ext_vector_type(8), aligned(4)));

@@ -185,7 +185,8 @@ __kernel void lanes(__global const float4 *a, __global const float4 *b, __global
     bx = vload8(0, x[3]); by = vload8(0, x[4]); bz = vload8(0, x[5]);
     float8 out[6] = {lanes_cross_term(ay, bz, az, by), lanes_cross_term(az, bx, ax, bz),
                      lanes_cross_term(ax, by, ay, bx), lanes_dot(ax, ay, az, bx, by, bz),
-                     lanes_length(ax, ay, az), as_float8(lanes_length_plain(ax, ay, az))};
+                     lanes_length(ax, ay, az),
+                     as_float8(lanes_length_plain(lanes_dot(ax, ay, az, ax, ay, az)))};
     for (int c = 0; c < 6; ++c)
         vstore8(out[c], 0, x[c]);
     for (int k = 0; k < 8; ++k)

@@ -261,12 +261,20 @@ ALWAYS_INLINE void kind_row_begin(__private const kind_patch *patch, float3 star
     cubic_differences(av[0], av[1], av[2], av[3], h, row->s_v);
 }
 
+/* `count` steps of a row with no point made (kind_row_next makes each point after one). */
+ALWAYS_INLINE void kind_row_skip(__private kind_row *row, int count)
+{
+    for (int k = 0; k < count; ++k) {
+        step_differences(row->s);
+        step_differences(row->s_u);
+        step_differences(row->s_v);
+    }
+}
+
 /* The row's next point, x its domain point (for the normal's fall-backs). */
 ALWAYS_INLINE void kind_row_next(__private const kind_patch *patch, __private kind_row *row, float3 x, __private float3 *position, __private float3 *normal)
 {
-    step_differences(row->s);
-    step_differences(row->s_u);
-    step_differences(row->s_v);
+    kind_row_skip(row, 1);
     float4 value = row->s[0];
     float3 p = projected(value);
     *position = p + patch->centre;
@@ -333,7 +341,7 @@ ALWAYS_INLINE void normal_lanes(const float8 s[4], const float8 s_u[4], const fl
     float8 nn = lanes_dot(nx, ny, nz, nx, ny, nz);
     int8 ok = nn > NORMAL_DEGENERATE * NORMAL_DEGENERATE * scale * scale;  /* tangent_cross */
     float8 len = lanes_length(nx, ny, nz);  /* normal_length */
-    *plain = ok & lanes_length_plain(nx, ny, nz) & (len > 0.0f);  /* unit_or's quotients */
+    *plain = ok & lanes_length_plain(nn) & (len > 0.0f);  /* unit_or's quotients */
     normal[0] = nx / len;
     normal[1] = ny / len;
     normal[2] = nz / len;
@@ -356,9 +364,7 @@ ALWAYS_INLINE void kind_row_next_lanes(__private const kind_patch *patch, __priv
     float4 value[KIND_LANES], d_u[KIND_LANES], d_v[KIND_LANES];
     __attribute__((opencl_unroll_hint))
     for (int k = 0; k < KIND_LANES; ++k) {
-        step_differences(row->s);
-        step_differences(row->s_u);
-        step_differences(row->s_v);
+        kind_row_skip(row, 1);
         value[k] = row->s[0];
         d_u[k] = row->s_u[0];
         d_v[k] = row->s_v[0];
@@ -373,15 +379,6 @@ ALWAYS_INLINE void kind_row_next_lanes(__private const kind_patch *patch, __priv
     position[2] = p[2] + patch->centre.z;
 }
 
-/* `count` steps of a row with no point made (the differences as kind_row_next steps them). */
-ALWAYS_INLINE void kind_row_skip(__private kind_row *row, int count)
-{
-    for (int k = 0; k < count; ++k) {
-        step_differences(row->s);
-        step_differences(row->s_u);
-        step_differences(row->s_v);
-    }
-}
 #endif
 
 #endif
