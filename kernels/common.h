@@ -214,6 +214,18 @@ ALWAYS_INLINE void store2_lanes(float8 x, float8 y, ulong at, __global float *ou
     to[0] = (float8)(x.s0, y.s0, x.s1, y.s1, x.s2, y.s2, x.s3, y.s3);
     to[1] = (float8)(x.s4, y.s4, x.s5, y.s5, x.s6, y.s6, x.s7, y.s7);
 }
+/* The 8 x 8 transpose: t[r] lane c is m[c] lane r. */
+ALWAYS_INLINE void transposed_lanes(const float8 m[8], float8 t[8])
+{
+    t[0] = (float8)(m[0].s0, m[1].s0, m[2].s0, m[3].s0, m[4].s0, m[5].s0, m[6].s0, m[7].s0);
+    t[1] = (float8)(m[0].s1, m[1].s1, m[2].s1, m[3].s1, m[4].s1, m[5].s1, m[6].s1, m[7].s1);
+    t[2] = (float8)(m[0].s2, m[1].s2, m[2].s2, m[3].s2, m[4].s2, m[5].s2, m[6].s2, m[7].s2);
+    t[3] = (float8)(m[0].s3, m[1].s3, m[2].s3, m[3].s3, m[4].s3, m[5].s3, m[6].s3, m[7].s3);
+    t[4] = (float8)(m[0].s4, m[1].s4, m[2].s4, m[3].s4, m[4].s4, m[5].s4, m[6].s4, m[7].s4);
+    t[5] = (float8)(m[0].s5, m[1].s5, m[2].s5, m[3].s5, m[4].s5, m[5].s5, m[6].s5, m[7].s5);
+    t[6] = (float8)(m[0].s6, m[1].s6, m[2].s6, m[3].s6, m[4].s6, m[5].s6, m[6].s6, m[7].s6);
+    t[7] = (float8)(m[0].s7, m[1].s7, m[2].s7, m[3].s7, m[4].s7, m[5].s7, m[6].s7, m[7].s7);
+}
 /* Whether every one of eight lanes is nonzero (all() is a call on PoCL).  Any nonzero: on Oclgrind
  * a vector comparison's true came out 1 after an &, where OpenCL says -1. */
 ALWAYS_INLINE int every_lane(int8 a)
@@ -306,25 +318,36 @@ inline float3 unit_or(float3 n, float3 otherwise)
 #endif
 }
 
-/* Power-form coefficients of the cubic Bernstein polynomial with controls c. */
-inline void power_form(const float4 c[4], float4 a[4])
-{
-    a[0] = c[0];
-    a[1] = 3.0f * (c[1] - c[0]);
-    a[2] = 3.0f * (c[2] - 2.0f * c[1] + c[0]);
-    a[3] = c[3] - 3.0f * c[2] + 3.0f * c[1] - c[0];
-}
+/* Power-form coefficients of the cubic Bernstein polynomial with controls c.  (One body for float4
+ * and for float8 lanes, power_form_lanes: a lane must do the same operations in the same order.) */
+#define POWER_FORM_BODY                                                                              \
+    {                                                                                                \
+        a[0] = c[0];                                                                                 \
+        a[1] = 3.0f * (c[1] - c[0]);                                                                 \
+        a[2] = 3.0f * (c[2] - 2.0f * c[1] + c[0]);                                                   \
+        a[3] = c[3] - 3.0f * c[2] + 3.0f * c[1] - c[0];                                              \
+    }
+inline void power_form(const float4 c[4], float4 a[4]) POWER_FORM_BODY
 
 /* Forward differences of a cubic a0 + a1 u + a2 u^2 + a3 u^3 at u = 0, step h (Wallace 1990):
- * value, first, second, third difference (docs/design.md section 6). */
+ * value, first, second, third difference (docs/design.md section 6).  (One body, as above.) */
+#define CUBIC_DIFFERENCES_BODY                                                                       \
+    {                                                                                                \
+        float h2 = h * h, h3 = h2 * h;                                                               \
+        d[0] = a0;                                                                                   \
+        d[1] = a1 * h + a2 * h2 + a3 * h3;                                                           \
+        d[2] = 2.0f * a2 * h2 + 6.0f * a3 * h3;                                                      \
+        d[3] = 6.0f * a3 * h3;                                                                       \
+    }
 inline void cubic_differences(float4 a0, float4 a1, float4 a2, float4 a3, float h, float4 d[4])
-{
-    float h2 = h * h, h3 = h2 * h;
-    d[0] = a0;
-    d[1] = a1 * h + a2 * h2 + a3 * h3;
-    d[2] = 2.0f * a2 * h2 + 6.0f * a3 * h3;
-    d[3] = 6.0f * a3 * h3;
-}
+    CUBIC_DIFFERENCES_BODY
+
+#if CLTESS_LANES
+ALWAYS_INLINE void power_form_lanes(const float8 c[4], float8 a[4]) POWER_FORM_BODY
+
+ALWAYS_INLINE void cubic_differences_lanes(float8 a0, float8 a1, float8 a2, float8 a3, float h, float8 d[4])
+    CUBIC_DIFFERENCES_BODY
+#endif
 
 inline void step_differences(float4 d[4])
 {

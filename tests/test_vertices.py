@@ -184,9 +184,12 @@ def test_lanes_are_the_points_one_by_one(rng, runtime):
     kinds/bezier.h: on by default on PoCL for x86-64 and on Intel's CPU runtime) write bitwise
     what one point at a time writes, at every row and edge length around the lanes (7 points: no
     lanes; 8: one set; 9 .. 15: the last set overlaps the one before; 16 .. 63; transition
-    patterns' edges of other lengths), with the lanes that take surface_normal's fall-backs: a
-    patch folded so that t_u x t_v vanishes along a line (some lanes of a row, not the others), a
-    patch flat on a line (every lane), patches with a collapsed edge, and squared normals below
+    patterns' edges of other lengths), and KIND_LANES rows at once where a patch has that many of
+    at least 9 points (put_row_block: 8 .. 62 rows, the last block overlapping the one before),
+    with the lanes that take surface_normal's fall-backs: a patch folded so that t_u x t_v
+    vanishes along a line across its rows (some lanes of a row, not the others) and one along a
+    row (some rows of a block, not the others), a patch flat on a line (every lane), patches
+    with a collapsed edge, and squared normals below
     FLT_MIN (coordinates of 1e-10) or infinite (1e10) where t_u x t_v does not vanish against the
     tangents: length's scaled branches.  The lanes compute the builtins in the forms of the
     runtimes where they are the default (common.h), so this runs on those two."""
@@ -199,6 +202,7 @@ def test_lanes_are_the_points_one_by_one(rng, runtime):
         pytest.skip("PoCL's lanes are its forms on x86-64")
     patches = [random_patches(rng, 120, spread=1.0)]
     patches.append(np.stack([folded_patch()] * 8))
+    patches.append(np.stack([folded_patch().transpose(1, 0, 2)] * 8))  # folded along v = 1/2
     patches.append(np.stack([folded_patch() * [1.0, 0.0, 0.0, 1.0]] * 2))  # on the line y = z = 0
     collapsed = random_patches(rng, 6, spread=1.0)
     collapsed[:, 0] = collapsed[:, 0, :1]  # edge 0 (v = 0) one point, as the teapot's lid
@@ -213,6 +217,7 @@ def test_lanes_are_the_points_one_by_one(rng, runtime):
     whole = rng.random(count) < 0.5  # uniform rows of every length from 1 to 63 points
     factors[whole] = (np.arange(count) % 64 + 1)[whole, None]
     factors[-26:] = 16
+    factors[128:136] = np.array([10, 12, 16, 20, 24, 32, 40, 64])[:, None]  # the row v = 1/2 in one block or two
     with_lanes = lanes_vertices(engine, patches, factors, 1)
     one_by_one = lanes_vertices(engine, patches, factors, 0)
     for name in with_lanes:

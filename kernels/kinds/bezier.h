@@ -293,7 +293,8 @@ ALWAYS_INLINE void kind_row_next(__private const kind_patch *patch, __private ki
  * is not its plain value (lanes_length_plain: PoCL's scaled branches) or not positive, is not
  * "plain": stages/rows.h then makes the eight points one by one by the scalar functions
  * (put_row_lanes, put_ring_lanes).  The kind's side of the contract: KIND_LANES,
- * kind_row_next_lanes, kind_row_skip, kind_eval_lanes (docs/extending.md). */
+ * kind_row_next_lanes, kind_row_skip, kind_eval_lanes, kind_rows, kind_rows_begin, kind_rows_next
+ * (docs/extending.md). */
 #define KIND_LANES 8
 
 /* bernstein3 / bernstein2 of eight lanes (common.h: the same body). */
@@ -301,22 +302,45 @@ ALWAYS_INLINE void bernstein3_lanes(float8 t, float8 b[4]) BERNSTEIN3_OF(float8)
 
 ALWAYS_INLINE void bernstein2_lanes(float8 t, float8 b[3]) BERNSTEIN2_OF(float8)
 
-/* surface_eval at eight points (u, v): B, B_u, B_v by component (s[c] is component c's lanes). */
+/* row_controls' component k at eight v, given bernstein3 / bernstein2 of them (bv, dv). */
+ALWAYS_INLINE void row_controls_lanes(const float4 b[16], const float8 bv[4], const float8 dv[3], int k,
+                                      float8 c[4], float8 d[4])
+{
+    for (int i = 0; i < 4; ++i) {
+        c[i] = bv[0] * b[i][k] + bv[1] * b[4 + i][k] + bv[2] * b[8 + i][k] + bv[3] * b[12 + i][k];
+        d[i] = 3.0f * (dv[0] * (b[4 + i][k] - b[i][k]) + dv[1] * (b[8 + i][k] - b[4 + i][k])
+                       + dv[2] * (b[12 + i][k] - b[8 + i][k]));
+    }
+}
+
+/* surface_eval at eight points (u, v): B, B_u, B_v by component (s[c] is component c's lanes).
+ * Where the eight share their v bitwise (a ring edge along u), row_controls is made once, its
+ * components copied to every lane: the same operations as each lane's. */
 ALWAYS_INLINE void surface_eval_lanes(const float4 b[16], float8 u, float8 v, float8 s[4], float8 s_u[4],
                                       float8 s_v[4])
 {
-    float8 bv[4], dv[3], bu[4], du[3];
-    bernstein3_lanes(v, bv);
-    bernstein2_lanes(v, dv);
+    float8 bu[4], du[3], controls[4][4], v_controls[4][4];  /* [k][i]: component k of row control i */
     bernstein3_lanes(u, bu);
     bernstein2_lanes(u, du);
-    for (int k = 0; k < 4; ++k) {  /* row_controls, then the point, component k */
-        float8 c[4], d[4];
-        for (int i = 0; i < 4; ++i) {
-            c[i] = bv[0] * b[i][k] + bv[1] * b[4 + i][k] + bv[2] * b[8 + i][k] + bv[3] * b[12 + i][k];
-            d[i] = 3.0f * (dv[0] * (b[4 + i][k] - b[i][k]) + dv[1] * (b[8 + i][k] - b[4 + i][k])
-                           + dv[2] * (b[12 + i][k] - b[8 + i][k]));
-        }
+    if (every_lane(as_int8(v) == (int8)(as_int(v.s0)))) {
+        float4 one_c[4], one_d[4];
+        row_controls(b, v.s0, one_c, one_d);
+        __attribute__((opencl_unroll_hint))
+        for (int k = 0; k < 4; ++k)
+            for (int i = 0; i < 4; ++i) {
+                controls[k][i] = (float8)(one_c[i][k]);
+                v_controls[k][i] = (float8)(one_d[i][k]);
+            }
+    } else {
+        float8 bv[4], dv[3];
+        bernstein3_lanes(v, bv);
+        bernstein2_lanes(v, dv);
+        __attribute__((opencl_unroll_hint))
+        for (int k = 0; k < 4; ++k)
+            row_controls_lanes(b, bv, dv, k, controls[k], v_controls[k]);
+    }
+    for (int k = 0; k < 4; ++k) {  /* the point, component k */
+        const float8 *c = controls[k], *d = v_controls[k];
         s[k] = bu[0] * c[0] + bu[1] * c[1] + bu[2] * c[2] + bu[3] * c[3];
         s_u[k] = 3.0f * (du[0] * (c[1] - c[0]) + du[1] * (c[2] - c[1]) + du[2] * (c[3] - c[2]));
         s_v[k] = bu[0] * d[0] + bu[1] * d[1] + bu[2] * d[2] + bu[3] * d[3];
@@ -375,6 +399,60 @@ ALWAYS_INLINE void kind_row_next_lanes(__private const kind_patch *patch, __priv
     lanes_of(d_v, s_v);
     normal_lanes(s, s_u, s_v, p, normal, plain);
     position[0] = p[0] + patch->centre.x;  /* kind_row_next's p + centre */
+    position[1] = p[1] + patch->centre.y;
+    position[2] = p[2] + patch->centre.z;
+}
+
+/* KIND_LANES rows at once, a row a lane (stages/rows.h put_row_block): each lane kind_row_begin'd
+ * and stepped as kind_row, component by component; s[m][k] is difference m of component k. */
+typedef struct {
+    float8 s[4][4], s_u[4][4], s_v[4][4];
+} kind_rows;
+
+/* kind_row_begin of the rows v (a lane each), all in `steps` steps. */
+ALWAYS_INLINE void kind_rows_begin(__private const kind_patch *patch, float8 v, int steps, __private kind_rows *rows)
+{
+    float h = 1.0f / (float)steps;
+    float8 bv[4], dv[3];
+    bernstein3_lanes(v, bv);
+    bernstein2_lanes(v, dv);
+    __attribute__((opencl_unroll_hint))
+    for (int k = 0; k < 4; ++k) {
+        float8 c[4], d[4], a[4], av[4], s[4], s_u[4], s_v[4];
+        row_controls_lanes(patch->t, bv, dv, k, c, d);
+        power_form_lanes(c, a);
+        power_form_lanes(d, av);
+        cubic_differences_lanes(a[0], a[1], a[2], a[3], h, s);
+        cubic_differences_lanes(a[1], 2.0f * a[2], 3.0f * a[3], (float8)(0.0f), h, s_u);
+        cubic_differences_lanes(av[0], av[1], av[2], av[3], h, s_v);
+        for (int m = 0; m < 4; ++m) {
+            rows->s[m][k] = s[m];
+            rows->s_u[m][k] = s_u[m];
+            rows->s_v[m][k] = s_v[m];
+        }
+    }
+}
+
+/* kind_row_next of every row: each row's next point, positions and normals by component (a lane a
+ * row), *plain as normal_lanes. */
+ALWAYS_INLINE void kind_rows_next(__private const kind_patch *patch, __private kind_rows *rows, float8 position[3],
+                                  float8 normal[3], __private int8 *plain)
+{
+    float8 s[4], s_u[4], s_v[4], p[3];
+    __attribute__((opencl_unroll_hint))
+    for (int k = 0; k < 4; ++k) {  /* step_differences, component k */
+        __attribute__((opencl_unroll_hint))
+        for (int m = 0; m < 3; ++m) {
+            rows->s[m][k] += rows->s[m + 1][k];
+            rows->s_u[m][k] += rows->s_u[m + 1][k];
+            rows->s_v[m][k] += rows->s_v[m + 1][k];
+        }
+        s[k] = rows->s[0][k];
+        s_u[k] = rows->s_u[0][k];
+        s_v[k] = rows->s_v[0][k];
+    }
+    normal_lanes(s, s_u, s_v, p, normal, plain);
+    position[0] = p[0] + patch->centre.x;
     position[1] = p[1] + patch->centre.y;
     position[2] = p[2] + patch->centre.z;
 }

@@ -70,6 +70,78 @@ ALWAYS_INLINE void put_row_lanes(__private const kind_patch *patch, int4 f, int 
         put_vertex(out, at + k, alone_position, alone_normal, x[k].xy, p, object);
     }
 }
+
+/* Whether rows j .. j + KIND_LANES - 1 all have `steps` steps, at least KIND_LANES + 1 (a block). */
+ALWAYS_INLINE int rows_alike(int4 f, int j, int steps)
+{
+    int alike = steps > KIND_LANES;
+    for (int r = 1; r < KIND_LANES; ++r)
+        alike &= pattern_row(f, j + r) == steps;
+    return alike;
+}
+
+/* Points first .. first + KIND_LANES - 1 of rows j .. j + KIND_LANES - 1 (each `points` long, row j's
+ * first point at output slot at) to their slots: made[c][(i - 1) % KIND_LANES] holds component c
+ * (position x, y, z, normal x, y, z) of point i of every row, a lane a row; transposed, a lane a
+ * point. */
+ALWAYS_INLINE void put_block_points(int4 f, int j, int points, int first, float8 made[6][KIND_LANES],
+                                    vertex_out out, ulong at, uint p, int object)
+{
+    float8 along[6][KIND_LANES];
+    __attribute__((opencl_unroll_hint))
+    for (int c = 0; c < 6; ++c) {
+        float8 by_point[KIND_LANES];
+        __attribute__((opencl_unroll_hint))
+        for (int k = 0; k < KIND_LANES; ++k)
+            by_point[k] = made[c][(first - 1 + k) & (KIND_LANES - 1)];
+        transposed_lanes(by_point, along[c]);
+    }
+    for (int r = 0; r < KIND_LANES; ++r) {
+        float3 x[KIND_LANES];
+        __attribute__((opencl_unroll_hint))
+        for (int k = 0; k < KIND_LANES; ++k)
+            x[k] = pattern_row_point(f, j + r, first + k);
+        float8 domain[3], position[3] = {along[0][r], along[1][r], along[2][r]},
+                          normal[3] = {along[3][r], along[4][r], along[5][r]};
+        lanes_of3(x, domain);
+        put_vertex_lanes(out, at + (ulong)(r * points + first - 1), position, normal, domain[0], domain[1], p, object);
+    }
+}
+
+/* Rows j .. j + KIND_LANES - 1 (rows_alike, `steps` steps each) a row a lane, from output slot at
+ * (row j's first point): stepped together (kind_rows_begin / kind_rows_next), each set of
+ * KIND_LANES points of every row transposed and written as put_row_lanes writes it, the last set
+ * overlapping the one before.  Bitwise what put_rows' one row at a time writes, where every lane
+ * was plain: returns whether they all were (otherwise the caller writes the rows again one by
+ * one). */
+ALWAYS_INLINE int put_row_block(__private const kind_patch *patch, int4 f, int j, int steps, vertex_out out, ulong at,
+                                uint p, int object)
+{
+    float v[KIND_LANES];
+    __attribute__((opencl_unroll_hint))
+    for (int r = 0; r < KIND_LANES; ++r)
+        v[r] = pattern_row_point(f, j + r, 0).y;
+    kind_rows rows;
+    kind_rows_begin(patch, (float8)(v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]), steps, &rows);
+    int points = steps - 1;
+    float8 made[6][KIND_LANES];
+    int8 plain = (int8)(-1);
+    for (int i = 1; i <= points; ++i) {
+        float8 position[3], normal[3];
+        int8 ok;
+        kind_rows_next(patch, &rows, position, normal, &ok);
+        plain &= ok;
+        int slot = (i - 1) & (KIND_LANES - 1);
+        __attribute__((opencl_unroll_hint))
+        for (int c = 0; c < 3; ++c) {
+            made[c][slot] = position[c];
+            made[3 + c][slot] = normal[c];
+        }
+        if ((i & (KIND_LANES - 1)) == 0 || i == points)
+            put_block_points(f, j, points, i - (KIND_LANES - 1), made, out, at, p, object);
+    }
+    return every_lane(plain);
+}
 #endif
 
 /* The ring of patch p from output slot at; returns the slot after it.  Where the kind has lanes
@@ -183,8 +255,24 @@ ALWAYS_INLINE void put_rows(__private const kind_patch *patch, int4 f, int colla
     forward_differencing = 0;  /* the rows' points are not equally spaced (patterns/layout.h) */
 #endif
     float3 position, normal;
+#if defined(KIND_LANES) && !PATTERN_CHORD_POINTS
+    int alone_until = first_row - 1;  /* rows up to it one at a time: a block of them was not plain */
+#endif
     for (int j = first_row; j <= last_row; ++j) {
         int steps = pattern_row(f, j);
+#if defined(KIND_LANES) && !PATTERN_CHORD_POINTS
+        /* KIND_LANES rows at once, the last block overlapping the one before (CPU runtimes) */
+        int block = imin(j, last_row - (KIND_LANES - 1));
+        if (forward_differencing && j > alone_until && block >= first_row && rows_alike(f, block, steps)) {
+            ulong block_at = at - (ulong)((j - block) * (steps - 1));
+            int plain = put_row_block(patch, f, block, steps, out, block_at, p, object);
+            if (!plain)  /* the block's rows again from its first, one at a time */
+                alone_until = block + KIND_LANES - 1;
+            at = plain ? block_at + (ulong)(KIND_LANES * (steps - 1)) : block_at;
+            j = plain ? block + KIND_LANES - 1 : block - 1;
+            continue;
+        }
+#endif
         if (forward_differencing) {
             kind_row row;
             kind_row_begin(patch, pattern_row_point(f, j, 0), pattern_row_point(f, j, steps), steps, &row);
