@@ -75,7 +75,7 @@ ALWAYS_INLINE void put_row_lanes(__private const kind_patch *patch, int4 f, int 
 ALWAYS_INLINE int rows_alike(int4 f, int j, int steps)
 {
     int alike = steps > KIND_LANES;
-    for (int r = 1; r < KIND_LANES; ++r)
+    for (int r = 0; r < KIND_LANES; ++r)
         alike &= pattern_row(f, j + r) == steps;
     return alike;
 }
