@@ -165,6 +165,19 @@ def all_culled():
     return scene, dict(pixels=1.0)
 
 
+def folded_rows():
+    """One patch folded along v = 1/2 (t_v vanishes on that row, so its normals take
+    surface_normal's fall-backs), at factor 12: 11 rows of 11 points.  With the CPU runtimes'
+    lanes (LANES) its rows go in two overlapping blocks of 8 (stages/rows.h put_row_block), the
+    row at the fold is in both, and both are written again one row at a time."""
+    from cltess.scene import Scene
+
+    x, y = np.meshgrid([0.0, 1.0, 0.0, 1.0], np.arange(4) / 3.0, indexing="xy")
+    folded = np.stack([x, y, 0.1 * x * y, np.ones_like(x)], -1).transpose(1, 0, 2)  # x folds along v
+    folded[:, :, 2] += 0.3 * np.array([0.0, 1.0, 1.0, 0.0])  # a bump along u: factors 12 both ways
+    return Scene(folded[None], np.zeros(1, np.int32), None, "folded"), dict(eps=1e-4, max_factor=12)
+
+
 def collapsed_lid():
     """Teapot lid top (patches 20-23): each has edge 0 collapsed to the knob's centre."""
     return teapot([20, 21, 22, 23]), dict(eps=0.02, max_factor=8)
@@ -375,6 +388,7 @@ SCENARIOS = {
     "saturated": saturated,
     "culled": culled,
     "all_culled": all_culled,
+    "folded_rows": folded_rows,
     "collapsed_lid": collapsed_lid,
     "collapsed_bottom_direct": collapsed_bottom_direct,
     "rational_sphere": rational_sphere,
@@ -468,10 +482,12 @@ UNINITIALIZED_SKIPPED = {
 
 #: Scenarios whose stage 4 makes a row's or a ring edge's points eight at a time (kernels/common.h
 #: CLTESS_LANES, the CPU runtimes' default, forced here: -D CLTESS_LANES=1), on rows and edges of 9
-#: to 24 points (the last eight overlap the eight before), the rational sphere's with its
-#: collapsed poles: the base scenario and options to change.
+#: to 24 points (the last eight overlap the eight before; blocks of 8 rows), the rational sphere's
+#: with its collapsed poles, the folded patch's blocks written again row by row: the base scenario
+#: and options to change (none: tests/test_oclgrind.py compares the output with the base's).
 LANES = {"uniform_fine_by_lanes": ("uniform_fine", {}),
-         "rational_sphere_by_lanes": ("rational_sphere", {"eps": 0.001, "max_factor": 12})}
+         "rational_sphere_by_lanes": ("rational_sphere", {"eps": 0.001, "max_factor": 12}),
+         "folded_rows_by_lanes": ("folded_rows", {})}
 
 #: Scenarios whose stage 4 runs a work-item per (patch, row) (stages/vertex_rows.cl), with 3
 #: work-items per patch so that the last one does the remaining rows too.

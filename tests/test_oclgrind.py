@@ -237,6 +237,12 @@ def test_results_match_pocl(oclgrind, tmp_path_factory, tessellator, pass_name):
                 by_points = load_npz(run.out_dir / f"{points}.npz")
                 for field in ("positions", "normals", "uv", "patch_ids", "object_ids", "triangles"):
                     assert np.array_equal(getattr(by_points, field), getattr(got, field)), f"{points}: {field}"
+        for lanes, (base, changes) in scenarios.LANES.items():  # the CPU runtimes' lanes, forced: the
+            if base == name and not changes and lanes in run.results:  # same but for the normals' builtins
+                by_lanes = load_npz(run.out_dir / f"{lanes}.npz")
+                for field in ("positions", "uv", "patch_ids", "object_ids", "triangles", "factors"):
+                    assert np.array_equal(getattr(by_lanes, field), getattr(got, field)), f"{lanes}: {field}"
+                np.testing.assert_allclose(by_lanes.normals, got.normals, rtol=0, atol=1e-6, err_msg=lanes)
         for frame, (base, _) in scenarios.FRAMES.items():  # a frame run again on grown buffers: the same
             if base == name and frame in run.results:
                 assert run.results[frame]["stats"]["output_fit"] is False, frame
