@@ -349,12 +349,18 @@ ALWAYS_INLINE void cubic_differences_lanes(float8 a0, float8 a1, float8 a2, floa
     CUBIC_DIFFERENCES_BODY
 #endif
 
-inline void step_differences(float4 d[4])
-{
-    d[0] += d[1];
-    d[1] += d[2];
-    d[2] += d[3];
-}
+/* One step of forward differences d (one body for float4 and for float8 lanes, as above). */
+#define STEP_DIFFERENCES_BODY                                                                        \
+    {                                                                                                \
+        d[0] += d[1];                                                                                \
+        d[1] += d[2];                                                                                \
+        d[2] += d[3];                                                                                \
+    }
+inline void step_differences(float4 d[4]) STEP_DIFFERENCES_BODY
+
+#if CLTESS_LANES
+ALWAYS_INLINE void step_differences_lanes(float8 d[4]) STEP_DIFFERENCES_BODY
+#endif
 
 /* --- boundary points (docs/design.md section 4) ---------------------------------------------- */
 

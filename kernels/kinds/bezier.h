@@ -404,7 +404,7 @@ ALWAYS_INLINE void kind_row_next_lanes(__private const kind_patch *patch, __priv
 }
 
 /* KIND_LANES rows at once, a row a lane (stages/rows.h put_row_block): each lane kind_row_begin'd
- * and stepped as kind_row, component by component; s[m][k] is difference m of component k. */
+ * and stepped as kind_row, component by component; s[k] holds component k's differences. */
 typedef struct {
     float8 s[4][4], s_u[4][4], s_v[4][4];
 } kind_rows;
@@ -418,18 +418,13 @@ ALWAYS_INLINE void kind_rows_begin(__private const kind_patch *patch, float8 v, 
     bernstein2_lanes(v, dv);
     __attribute__((opencl_unroll_hint))
     for (int k = 0; k < 4; ++k) {
-        float8 c[4], d[4], a[4], av[4], s[4], s_u[4], s_v[4];
+        float8 c[4], d[4], a[4], av[4];
         row_controls_lanes(patch->t, bv, dv, k, c, d);
         power_form_lanes(c, a);
         power_form_lanes(d, av);
-        cubic_differences_lanes(a[0], a[1], a[2], a[3], h, s);
-        cubic_differences_lanes(a[1], 2.0f * a[2], 3.0f * a[3], (float8)(0.0f), h, s_u);
-        cubic_differences_lanes(av[0], av[1], av[2], av[3], h, s_v);
-        for (int m = 0; m < 4; ++m) {
-            rows->s[m][k] = s[m];
-            rows->s_u[m][k] = s_u[m];
-            rows->s_v[m][k] = s_v[m];
-        }
+        cubic_differences_lanes(a[0], a[1], a[2], a[3], h, rows->s[k]);
+        cubic_differences_lanes(a[1], 2.0f * a[2], 3.0f * a[3], (float8)(0.0f), h, rows->s_u[k]);
+        cubic_differences_lanes(av[0], av[1], av[2], av[3], h, rows->s_v[k]);
     }
 }
 
@@ -440,16 +435,13 @@ ALWAYS_INLINE void kind_rows_next(__private const kind_patch *patch, __private k
 {
     float8 s[4], s_u[4], s_v[4], p[3];
     __attribute__((opencl_unroll_hint))
-    for (int k = 0; k < 4; ++k) {  /* step_differences, component k */
-        __attribute__((opencl_unroll_hint))
-        for (int m = 0; m < 3; ++m) {
-            rows->s[m][k] += rows->s[m + 1][k];
-            rows->s_u[m][k] += rows->s_u[m + 1][k];
-            rows->s_v[m][k] += rows->s_v[m + 1][k];
-        }
-        s[k] = rows->s[0][k];
-        s_u[k] = rows->s_u[0][k];
-        s_v[k] = rows->s_v[0][k];
+    for (int k = 0; k < 4; ++k) {  /* kind_row_skip's step, component k */
+        step_differences_lanes(rows->s[k]);
+        step_differences_lanes(rows->s_u[k]);
+        step_differences_lanes(rows->s_v[k]);
+        s[k] = rows->s[k][0];
+        s_u[k] = rows->s_u[k][0];
+        s_v[k] = rows->s_v[k][0];
     }
     normal_lanes(s, s_u, s_v, p, normal, plain);
     position[0] = p[0] + patch->centre.x;
