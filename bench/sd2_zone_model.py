@@ -14,6 +14,8 @@ sequential: leaving the plateau of 3 or 5 with c+2 following after a delay (the 
 triple: a loop of radius r factor units around a triple tie at factor n (phi_k = n + r cos(theta
   + 2 pi k / 3), 72 angles): its diameter (the largest distance between two of its meshes, each
   against every sixth other).  A pop at the triple point: the diameter does not shrink with r.
+  Also in units of the mesh's own error at n (the hinted grid at n against the grid of 41), the
+  residual that docs/sd2.md section 5, "Decision", states; ``--factors`` chooses the n.
 passing: a path passing within about 0.01 of a triple tie at n (sphere-320 depth's worst patches
   pass one at 2.86): the worst step at 0.02 / 0.01 factor units, for two orders of the corners
   (eighth pass).
@@ -53,6 +55,7 @@ def departures(plateaus=(1, 3, 7), rates=(0.25, 0.5, 0.75), step=1 / 64):
 def triple(factors=(1.05, 1.2, 1.5, 2.0, 3.05), radii=(0.02, 0.005)):
     error = model.plateau_error(1)
     for n in factors:
+        own_error = model.lifted_distance(record([n] * 3), record([41] * 3))
         diameters = []
         for r in radii:
             meshes = [model.lifted(record([n + r * np.cos(theta + 2 * np.pi * k / 3) for k in range(3)]))
@@ -65,7 +68,8 @@ def triple(factors=(1.05, 1.2, 1.5, 2.0, 3.05), radii=(0.02, 0.005)):
                                 model.point_triangle_distances(pb, ta).max())
             diameters.append(worst / error)
         print(f"triple tie at {n}: loop diameter " + ", ".join(f"r = {r}: {d:.3f}" for r, d in zip(radii, diameters))
-              + " of the factor-1 error", flush=True)
+              + " of the factor-1 error; " + ", ".join(f"{d * error / own_error:.3f}" for d in diameters)
+              + f" of the error at {n}", flush=True)
 
 
 def sequential(plateaus=(3, 5), rates=(0.3, 0.75), delays=(0.0, 0.005, 0.02), steps=(0.02, 0.01)):
@@ -101,12 +105,13 @@ def passing(factors=(2.0, 2.5, 2.86, 3.0, 3.05, 4.0, 5.0, 6.3), steps=(0.02, 0.0
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("part", nargs="?", choices=("departures", "triple", "sequential", "passing", "both"), default="both")
+    parser.add_argument("--factors", type=float, nargs="*", help="triple: the factors n of the triple ties")
     args = parser.parse_args()
     print(f"tree {TREE}")
     if args.part in ("departures", "both"):
         departures()
     if args.part in ("triple", "both"):
-        triple()
+        triple(*([args.factors] if args.factors else []))
     if args.part == "sequential":
         sequential()
     if args.part == "passing":
