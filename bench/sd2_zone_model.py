@@ -55,18 +55,8 @@ def departures(plateaus=(1, 3, 7), rates=(0.25, 0.5, 0.75), step=1 / 64):
 def triple(factors=(1.05, 1.2, 1.5, 2.0, 3.05), radii=(0.02, 0.005)):
     error = model.plateau_error(1)
     for n in factors:
-        own_error = model.lifted_distance(record([n] * 3), record([41] * 3))
-        diameters = []
-        for r in radii:
-            meshes = [model.lifted(record([n + r * np.cos(theta + 2 * np.pi * k / 3) for k in range(3)]))
-                      for theta in np.linspace(0, 2 * np.pi, 72, endpoint=False)]
-            worst = 0.0
-            for a in range(len(meshes)):
-                for b in range(a + 1, len(meshes), 6):
-                    (pa, ta), (pb, tb) = meshes[a], meshes[b]
-                    worst = max(worst, model.point_triangle_distances(pa, tb).max(),
-                                model.point_triangle_distances(pb, ta).max())
-            diameters.append(worst / error)
+        own_error = model.plateau_error(n)
+        diameters = [model.triple_tie_loop_diameter(n, r, angles=72, stride=6) / error for r in radii]
         print(f"triple tie at {n}: loop diameter " + ", ".join(f"r = {r}: {d:.3f}" for r, d in zip(radii, diameters))
               + " of the factor-1 error; " + ", ".join(f"{d * error / own_error:.3f}" for d in diameters)
               + f" of the error at {n}", flush=True)
