@@ -2,6 +2,10 @@
 # (prepared_ring, a work-item per ring point) beside prepared_rows walking the interior rows alone,
 # against the session's start (probe/base16 = git archive HEAD cltess kernels bench scenes).
 # From /work/main, carry [".whl", "probe/base16"].
+# This is run 2 (ring2.*, tests2.txt). Run 1 (ring1.txt) ran an earlier form of the kernel: the
+# ring's edge a runtime index into ring_position / kind_eval. Its variants were apart-32x8 and
+# apart-64x16 in place of apart-128x16, and this script had no link for probe/base16, so the
+# "before" rows failed there.
 . bench/gpu_setup.sh >/dev/null || exit 1
 ln -sfn ../kernels probe/base16/cltess/kernels
 R=$OUT/ring; mkdir -p $R
