@@ -54,6 +54,15 @@ from .scene import Camera, Scene
 from .tessellation import Tessellation
 
 
+def _cuda_outputs():
+    from .backends.opencl.share_cuda import CudaOutputBuffers
+    return CudaOutputBuffers
+
+
+#: Session(share=...): the output buffers' class, by the API the output is handed to.
+SHARED_OUTPUTS = {None: lambda: OutputBuffers, "cuda": _cuda_outputs}
+
+
 @dataclass
 class FrameBuffers:
     """What a frame writes, one set of it (``Session(buffers=N)`` keeps N, taken in turn): the
@@ -73,18 +82,23 @@ class Session:
     give ``tessellator`` (to share its context and programs); request: a ``Request``, or its
     parts as keywords (``Request.of``: eps= or pixels=, max_factor=, pattern=, ...).  buffers:
     sets of output buffers that frames take in turn (the module's notes): 1, or 2 so that a
-    frame's output stays valid while the next frame computes.
+    frame's output stays valid while the next frame computes.  share: "cuda" to hand each
+    frame's output to CUDA without a copy (``frame.cuda()``; an NVIDIA device:
+    backends/opencl/share_cuda.py), else None.
     """
 
     def __init__(self, scene: Scene, device=None, request: Request | None = None,
-                 tessellator: Tessellator | None = None, buffers: int = 1, **options):
+                 tessellator: Tessellator | None = None, buffers: int = 1, share: str | None = None, **options):
         if isinstance(buffers, bool) or not isinstance(buffers, int) or buffers < 1:
             raise ValueError(f"buffers must be a whole number >= 1, got {buffers!r}")
+        if share not in SHARED_OUTPUTS:
+            raise ValueError(f"share={share!r}: expected one of {', '.join(map(repr, SHARED_OUTPUTS))}")
         self.tessellator = tessellator if tessellator is not None else Tessellator(device)
         self.scene = scene
         self.request = request if request is not None else Request.of(**options)
         self.request.check(scene)
-        self._sets = [FrameBuffers(OutputBuffers(self.tessellator, pinned=True)) for _ in range(buffers)]
+        outputs = SHARED_OUTPUTS[share]()
+        self._sets = [FrameBuffers(outputs(self.tessellator, pinned=True)) for _ in range(buffers)]
         self._current = self._sets[0]  # the set of the latest frame (the next frame's before the first)
         self._scene_data: dict = {}  # sharp_edges -> SceneData
         self.frames = 0

@@ -48,7 +48,9 @@ class DeviceOutput:
     read_back: returns the host arrays (a dict with the same keys); valid: whether the buffers
     still hold this output (False once a session's next frame reused them); settle: called
     before the arrays or sizes are first given, for an output whose size the host learns late
-    (a Session frame, launched before stage 3's totals were read back).
+    (a Session frame, launched before stage 3's totals were read back); share: hands the
+    buffers to the API named by ``shares`` and returns its arrays (a Session made with
+    ``share="cuda"``), else None.
     """
 
     arrays: dict
@@ -57,6 +59,8 @@ class DeviceOutput:
     read_back: Callable[[], dict] | None = None
     valid: Callable[[], bool] = lambda: True
     settle: Callable[[], None] = lambda: None
+    share: Callable[[], dict] | None = None
+    shares: str | None = None
 
     def __getattr__(self, name):
         arrays = self.__dict__.get("arrays", {})
@@ -203,6 +207,19 @@ class Tessellation(IndexedMesh):
         self.wall_ms["total"] = self.wall_ms.get("stages", 0.0) + self.wall_ms["read_back"]
         self.stage_ms["total_wall"] = self.wall_ms["total"]
         return self
+
+    def cuda(self):
+        """The output as CUDA device arrays, no copy (``share_cuda.CudaArrays``: positions,
+        normals, uv, patch_ids, object_ids, triangles, each with ``__cuda_array_interface__``)
+        for a frame of ``Session(..., share="cuda")``.  Waits for the frame's stages; the arrays
+        are views of the session's buffers, valid until its next ``tessellate`` call."""
+        device = self.__dict__.get("device")
+        if device is None or device.shares != "cuda":
+            raise ValueError("cuda() is for the frames of a Session made with share=\"cuda\"")
+        device.check()
+        self.finish()
+        device.settle()
+        return device.share()
 
     @property
     def num_vertices(self) -> int:

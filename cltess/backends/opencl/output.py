@@ -85,6 +85,8 @@ class OutputBuffers:
     """
 
     GROWTH = 1.25
+    #: The API a subclass hands the buffers to without a copy (``share``), or None.
+    shares: str | None = None
 
     def __init__(self, tessellator: "Tessellator", pinned: bool = False):
         self.queue = tessellator.queue
@@ -130,7 +132,6 @@ class OutputBuffers:
         if self.mapped:
             self._take_mapped(layout, num_vertices, num_triangles)
         else:
-            flags = cl.mem_flags.READ_WRITE
             for name, dtype, shape in layout:
                 rows = num_triangles if name == "triangles" else num_vertices
                 row_bytes = dtype.itemsize * math.prod(shape)
@@ -139,11 +140,16 @@ class OutputBuffers:
                     capacity = rows if buffer is None else int(rows * self.GROWTH)
                     self._buffers.pop(name, None)
                     self._staging.pop(name, None)
-                    buffer = cl.Buffer(self.context, flags, max(capacity, 1) * row_bytes)
+                    buffer = self._new_buffer(name, max(capacity, 1) * row_bytes)
                     self._buffers[name] = (buffer, capacity)
         self._field_buffers = {name: self._buffers[name][0] for name, _, _ in layout}
         self._capacity = (min(capacity for name, (_, capacity) in self._buffers.items() if name != "triangles"),
                           self._buffers["triangles"][1])
+
+    def _new_buffer(self, name: str, nbytes: int) -> cl.Buffer:
+        """A device buffer of ``nbytes`` for field ``name`` (a buffer sharing its memory with
+        another API in a subclass: share_cuda.CudaOutputBuffers)."""
+        return cl.Buffer(self.context, cl.mem_flags.READ_WRITE, nbytes)
 
     def _take_mapped(self, layout, num_vertices: int, num_triangles: int) -> None:
         """A CPU device's buffers: every field a sub-buffer of one ``ALLOC_HOST_PTR`` allocation

@@ -1197,8 +1197,12 @@ class PendingEmit:
             host["factors"], host["real_factors"] = plan.output_factors(first, last)
             return host
 
+        def share():  # the output handed to another API (OutputBuffers.shares)
+            return buffers.share(current["arrays"].num_vertices, current["arrays"].num_triangles)
+
         device = DeviceOutput(self.arrays, self.tessellator.queue, self.vertex_base, read_back,
-                              valid=lambda: buffers.generation == current["generation"], settle=settle)
+                              valid=lambda: buffers.generation == current["generation"], settle=settle,
+                              share=share if buffers.shares else None, shares=buffers.shares)
         tess = Tessellation.on_device(device, None, None, None, self.strips, finish=finish)
         if wait:
             tess.finish()

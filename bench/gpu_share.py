@@ -1,0 +1,116 @@
+"""Issue 15: a Session's output handed to CUDA without a copy (``Session(share="cuda")``,
+``frame.cuda()``: cltess/backends/opencl/share_cuda.py), against the same frames kept on the
+OpenCL device and read back to host arrays, side by side in one run on one tessellator.
+
+    python bench/gpu_share.py --device nvidia [--frames 10] [--scenes tea_table killeroo ...] [--copies 1000]
+
+Per scene, for each camera of an orbit (frame_loop.orbit), three frames in turn:
+
+* **resident**: a plain Session frame, waited for (``tessellate`` then ``finish``): the output
+  on the OpenCL device;
+* **cuda**: a ``share="cuda"`` Session frame and ``frame.cuda()``: until the caller holds CUDA
+  device arrays (the buffers released by OpenCL and the release waited for);
+* **host**: a plain Session frame for host arrays (``tessellate(host=True)``: pinned copies).
+
+Each figure is the median over the frames of the host wall clock (``time.perf_counter``) from
+the call until the caller holds that output, and of the device time of stages 1-5
+(``stage_ms``).  ``--copies`` adds uniform level 16 on that many teapots (``eps`` far below what
+any factor reaches, ``max_factor`` 16; no camera, the same frame each time).  Each scene's last
+frames are compared: the CUDA arrays (copied to the host by CUDA) bitwise against the host
+frame's arrays.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import frame_loop  # noqa: E402  (suite_scene, orbit, teapots, uniform_request, device_ms)
+
+import cltess  # noqa: E402
+from cltess.backends.opencl import Tessellator  # noqa: E402
+from cltess.tessellation import HOST_FIELDS  # noqa: E402
+
+FIELDS = [name for name in HOST_FIELDS if name not in ("factors", "real_factors")]
+
+
+def timed(call):
+    started = time.perf_counter()
+    frame = call()
+    return frame, (time.perf_counter() - started) * 1e3
+
+
+def compare(shared: dict, host_frame) -> bool:
+    return all(np.array_equal(shared[name].get(), getattr(host_frame, name)) for name in FIELDS)
+
+
+def scene_rows(tessellator, name: str, scene, cameras, request: dict) -> dict:
+    plain = cltess.Session(scene, tessellator=tessellator, **request)
+    shared = cltess.Session(scene, tessellator=tessellator, share="cuda", **request)
+    for camera in cameras:  # builds, uploads, the buffers at the size the path needs
+        plain.tessellate(camera=camera).finish()
+        shared.tessellate(camera=camera).cuda()
+    rows = {"resident": [], "cuda": [], "host": []}
+    device = {"resident": [], "cuda": [], "host": []}
+    same = True
+    for camera in cameras:
+        frame, wall = timed(lambda: plain.tessellate(camera=camera).finish())
+        rows["resident"].append(wall)
+        device["resident"].append(frame_loop.device_ms(frame))
+        frame, wall = timed(lambda: shared.tessellate(camera=camera))
+        started = time.perf_counter()
+        arrays = frame.cuda()
+        rows["cuda"].append(wall + (time.perf_counter() - started) * 1e3)
+        device["cuda"].append(frame_loop.device_ms(frame))
+        host_frame, wall = timed(lambda: plain.tessellate(camera=camera, host=True))
+        rows["host"].append(wall)
+        device["host"].append(frame_loop.device_ms(host_frame))
+        same &= compare(arrays, host_frame)
+    return {"scene": name, "frames": len(cameras), "triangles": host_frame.num_triangles,
+            "bytes": frame_loop.output_bytes(host_frame), "same_bits": bool(same),
+            **{f"{kind}_wall_ms": statistics.median(values) for kind, values in rows.items()},
+            **{f"{kind}_device_ms": statistics.median(values) for kind, values in device.items()}}
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--device", default="nvidia")
+    parser.add_argument("--frames", type=int, default=10)
+    parser.add_argument("--scenes", nargs="*", default=["tea_table", "killeroo", "herd", "spheres"])
+    parser.add_argument("--copies", type=int, default=1000, help="teapots at uniform level 16 (0: none)")
+    parser.add_argument("--json", help="write the rows here too")
+    args = parser.parse_args(argv)
+    tessellator = Tessellator(args.device)
+    print(f"{tessellator.device.name} ({tessellator.device.platform.name}, {tessellator.device.driver_version}); "
+          f"work {tessellator.work}", flush=True)
+    rows = []
+    for key in args.scenes:
+        scene = frame_loop.suite_scene(key)
+        rows.append(scene_rows(tessellator, key, scene, list(frame_loop.orbit(scene.camera, args.frames)),
+                               {"pixels": frame_loop.PIXELS}))
+        print(rows[-1], flush=True)
+    if args.copies:
+        scene = frame_loop.teapots(args.copies)
+        rows.append(scene_rows(tessellator, f"{args.copies} teapots, level 16", scene, [None] * args.frames,
+                               frame_loop.uniform_request(16)))
+        print(rows[-1], flush=True)
+    print("\n| scene | triangles | MB | device ms (resident / cuda / host) | wall ms: resident | cuda "
+          "(until `frame.cuda()` returns) | host arrays | same bits |")
+    print("|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        print(f"| {r['scene']} | {r['triangles']:,} | {r['bytes'] / 1e6:.1f} | {r['resident_device_ms']:.3f} / "
+              f"{r['cuda_device_ms']:.3f} / {r['host_device_ms']:.3f} | {r['resident_wall_ms']:.3f} | "
+              f"{r['cuda_wall_ms']:.3f} | {r['host_wall_ms']:.3f} | {'yes' if r['same_bits'] else 'NO'} |")
+    if args.json:
+        Path(args.json).write_text(json.dumps(rows, indent=1))
+    return 0 if all(r["same_bits"] for r in rows) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
