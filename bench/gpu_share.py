@@ -10,7 +10,10 @@ Per scene, for each camera of an orbit (frame_loop.orbit), three frames in turn:
   on the OpenCL device;
 * **cuda**: a ``share="cuda"`` Session frame and ``frame.cuda()``: until the caller holds CUDA
   device arrays (the buffers released by OpenCL and the release waited for);
-* **host**: a plain Session frame for host arrays (``tessellate(host=True)``: pinned copies).
+* **host**: a plain Session frame for host arrays (``tessellate(host=True)``: pinned copies);
+* **gl** (where a headless GL context can be made: tests/support/egl.py): a ``share="gl"``
+  Session frame, ``frame.gl()``, then ``glFinish``: until GL has executed its wait for the
+  frame (``frame.gl()`` itself returns without waiting; its time is given apart).
 
 Each figure is the median over the frames of the host wall clock (``time.perf_counter``) from
 the call until the caller holds that output, and of the device time of stages 1-5
@@ -33,6 +36,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import frame_loop  # noqa: E402  (suite_scene, orbit, teapots, uniform_request, device_ms)
 
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+
 import cltess  # noqa: E402
 from cltess.backends.opencl import Tessellator  # noqa: E402
 from cltess.tessellation import HOST_FIELDS  # noqa: E402
@@ -50,14 +55,24 @@ def compare(shared: dict, host_frame) -> bool:
     return all(np.array_equal(shared[name].get(), getattr(host_frame, name)) for name in FIELDS)
 
 
-def scene_rows(tessellator, name: str, scene, cameras, request: dict) -> dict:
+def compare_gl(gl, buffers: dict, host_frame) -> bool:
+    return all(np.array_equal(gl.read(buffers[name].name, buffers[name].nbytes, getattr(host_frame, name).dtype,
+                                      getattr(host_frame, name).shape), getattr(host_frame, name)) for name in FIELDS)
+
+
+def scene_rows(tessellator, name: str, scene, cameras, request: dict, gl=None) -> dict:
     plain = cltess.Session(scene, tessellator=tessellator, **request)
     shared = cltess.Session(scene, tessellator=tessellator, share="cuda", **request)
+    to_gl = cltess.Session(scene, tessellator=tessellator, share="gl", **request) if gl else None
     for camera in cameras:  # builds, uploads, the buffers at the size the path needs
         plain.tessellate(camera=camera).finish()
         shared.tessellate(camera=camera).cuda()
-    rows = {"resident": [], "cuda": [], "host": []}
-    device = {"resident": [], "cuda": [], "host": []}
+        if gl:
+            to_gl.tessellate(camera=camera).gl()
+            gl.finish()
+    kinds = ("resident", "cuda", "host") + (("gl", "gl_call") if gl else ())
+    rows = {kind: [] for kind in kinds}
+    device = {kind: [] for kind in kinds}
     same = True
     for camera in cameras:
         frame, wall = timed(lambda: plain.tessellate(camera=camera).finish())
@@ -72,6 +87,18 @@ def scene_rows(tessellator, name: str, scene, cameras, request: dict) -> dict:
         rows["host"].append(wall)
         device["host"].append(frame_loop.device_ms(host_frame))
         same &= compare(arrays, host_frame)
+        if gl:
+            started = time.perf_counter()
+            frame = to_gl.tessellate(camera=camera)
+            buffers = frame.gl()
+            rows["gl_call"].append((time.perf_counter() - started) * 1e3)
+            gl.finish()
+            rows["gl"].append((time.perf_counter() - started) * 1e3)
+            device["gl"].append(frame_loop.device_ms(frame))
+            device["gl_call"].append(device["gl"][-1])
+            same &= compare_gl(gl, buffers, host_frame)
+    if gl:
+        to_gl.close()
     return {"scene": name, "frames": len(cameras), "triangles": host_frame.num_triangles,
             "bytes": frame_loop.output_bytes(host_frame), "same_bits": bool(same),
             **{f"{kind}_wall_ms": statistics.median(values) for kind, values in rows.items()},
@@ -85,7 +112,15 @@ def main(argv=None) -> int:
     parser.add_argument("--scenes", nargs="*", default=["tea_table", "killeroo", "herd", "spheres"])
     parser.add_argument("--copies", type=int, default=1000, help="teapots at uniform level 16 (0: none)")
     parser.add_argument("--json", help="write the rows here too")
+    parser.add_argument("--no-gl", action="store_true", help="leave out the share=\"gl\" frames")
     args = parser.parse_args(argv)
+    gl = None
+    if not args.no_gl:
+        from support.egl import HeadlessGL
+        try:
+            gl = HeadlessGL()
+        except RuntimeError as error:
+            print(f"no gl column: {error}")
     tessellator = Tessellator(args.device)
     print(f"{tessellator.device.name} ({tessellator.device.platform.name}, {tessellator.device.driver_version}); "
           f"work {tessellator.work}", flush=True)
@@ -93,20 +128,22 @@ def main(argv=None) -> int:
     for key in args.scenes:
         scene = frame_loop.suite_scene(key)
         rows.append(scene_rows(tessellator, key, scene, list(frame_loop.orbit(scene.camera, args.frames)),
-                               {"pixels": frame_loop.PIXELS}))
+                               {"pixels": frame_loop.PIXELS}, gl))
         print(rows[-1], flush=True)
     if args.copies:
         scene = frame_loop.teapots(args.copies)
         rows.append(scene_rows(tessellator, f"{args.copies} teapots, level 16", scene, [None] * args.frames,
-                               frame_loop.uniform_request(16)))
+                               frame_loop.uniform_request(16), gl))
         print(rows[-1], flush=True)
     print("\n| scene | triangles | MB | device ms (resident / cuda / host) | wall ms: resident | cuda "
-          "(until `frame.cuda()` returns) | host arrays | same bits |")
-    print("|---|---|---|---|---|---|---|---|")
+          "(until `frame.cuda()` returns) | host arrays | gl (until GL has waited) | of which until "
+          "`frame.gl()` returns | same bits |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
+        gl_cells = (f"{r['gl_wall_ms']:.3f} | {r['gl_call_wall_ms']:.3f}" if "gl_wall_ms" in r else "- | -")
         print(f"| {r['scene']} | {r['triangles']:,} | {r['bytes'] / 1e6:.1f} | {r['resident_device_ms']:.3f} / "
               f"{r['cuda_device_ms']:.3f} / {r['host_device_ms']:.3f} | {r['resident_wall_ms']:.3f} | "
-              f"{r['cuda_wall_ms']:.3f} | {r['host_wall_ms']:.3f} | {'yes' if r['same_bits'] else 'NO'} |")
+              f"{r['cuda_wall_ms']:.3f} | {r['host_wall_ms']:.3f} | {gl_cells} | {'yes' if r['same_bits'] else 'NO'} |")
     if args.json:
         Path(args.json).write_text(json.dumps(rows, indent=1))
     return 0 if all(r["same_bits"] for r in rows) else 1

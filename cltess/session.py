@@ -59,8 +59,13 @@ def _cuda_outputs():
     return CudaOutputBuffers
 
 
+def _gl_outputs():
+    from .backends.opencl.share_gl import GlOutputBuffers
+    return GlOutputBuffers
+
+
 #: Session(share=...): the output buffers' class, by the API the output is handed to.
-SHARED_OUTPUTS = {None: lambda: OutputBuffers, "cuda": _cuda_outputs}
+SHARED_OUTPUTS = {None: lambda: OutputBuffers, "cuda": _cuda_outputs, "gl": _gl_outputs}
 
 
 @dataclass
@@ -84,7 +89,9 @@ class Session:
     sets of output buffers that frames take in turn (the module's notes): 1, or 2 so that a
     frame's output stays valid while the next frame computes.  share: "cuda" to hand each
     frame's output to CUDA without a copy (``frame.cuda()``; an NVIDIA device:
-    backends/opencl/share_cuda.py), else None.
+    backends/opencl/share_cuda.py), "gl" to OpenGL (``frame.gl()``; made, used and closed with
+    the GL context current: backends/opencl/share_gl.py), else None.  ``close()`` (or a
+    ``with`` block) lets the buffers go at once.
     """
 
     def __init__(self, scene: Scene, device=None, request: Request | None = None,
@@ -243,6 +250,20 @@ class Session:
         device.settle()  # its totals; its stages 4-5 again where its output did not fit
         arrays = device.arrays  # (as settled: the sizes its fetch reads back, 0 included)
         pending.start_read_back((arrays.num_vertices, arrays.num_triangles))
+
+    def close(self) -> None:
+        """Let the output buffers go now; the session's frames are stale, and a later frame
+        makes new ones.  With share="gl": the GL objects are deleted (the session's GL context
+        current), and the session makes no more frames."""
+        for buffers in self._sets:
+            buffers.output.close()
+            buffers.recorded = None  # (its launches name the buffers let go)
+
+    def __enter__(self) -> "Session":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
 
     def _frame_key(self) -> tuple:
         """What a frame's launches depend on besides its camera: the tessellator's settings

@@ -50,7 +50,7 @@ class DeviceOutput:
     before the arrays or sizes are first given, for an output whose size the host learns late
     (a Session frame, launched before stage 3's totals were read back); share: hands the
     buffers to the API named by ``shares`` and returns its arrays (a Session made with
-    ``share="cuda"``), else None.
+    ``share="cuda"`` or ``"gl"``), else None.
     """
 
     arrays: dict
@@ -213,9 +213,20 @@ class Tessellation(IndexedMesh):
         normals, uv, patch_ids, object_ids, triangles, each with ``__cuda_array_interface__``)
         for a frame of ``Session(..., share="cuda")``.  Waits for the frame's stages; the arrays
         are views of the session's buffers, valid until its next ``tessellate`` call."""
+        return self._shared("cuda")
+
+    def gl(self):
+        """The output as buffer objects of the Session's OpenGL context, no copy
+        (``share_gl.GlBuffers``: each field's GL buffer name, rows and components) for a frame
+        of ``Session(..., share="gl")``; GL commands issued after the call see the frame (GL
+        waits on the device; the host does not).  Valid until the session's next ``tessellate``
+        call: issue the commands that use them before it."""
+        return self._shared("gl")
+
+    def _shared(self, api: str):
         device = self.__dict__.get("device")
-        if device is None or device.shares != "cuda":
-            raise ValueError("cuda() is for the frames of a Session made with share=\"cuda\"")
+        if device is None or device.shares != api:
+            raise ValueError(f"{api}() is for the frames of a Session made with share=\"{api}\"")
         device.check()
         self.finish()
         device.settle()

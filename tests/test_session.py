@@ -243,6 +243,16 @@ def test_session_overrides_and_growing_buffers(tessellator, tea_table):
     assert_same_output(semi, tessellator.tessellate(tea_table, eps=0.02, pattern="semi_uniform"))
 
 
+def test_closing_a_session_lets_its_buffers_go(tessellator, tea_table):
+    with cltess.Session(tea_table, tessellator=tessellator, eps=0.02) as session:
+        frame = session.tessellate()
+        assert session.output.nbytes > 0
+    assert session.output.nbytes == 0 and session.output.capacity == (0, 0)
+    with pytest.raises(StaleOutput):
+        frame.fetch()
+    assert_same_output(session.tessellate(eps=0.02), tessellator.tessellate(tea_table, eps=0.02))  # new buffers
+
+
 def test_session_refuses_what_it_cannot_do(tessellator, tea_table):
     session = cltess.Session(tea_table, tessellator=tessellator, eps=0.02)
     with pytest.raises(ValueError, match="pixel tolerance"):

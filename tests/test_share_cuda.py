@@ -42,8 +42,8 @@ def test_a_device_without_external_memory_refuses_to_share(tessellator, tea_tabl
 
 
 def test_a_session_refuses_an_api_it_cannot_hand_to(tessellator, tea_table):
-    with pytest.raises(ValueError, match="share='gl': expected one of None, 'cuda'"):
-        cltess.Session(tea_table, tessellator=tessellator, pixels=0.5, share="gl")
+    with pytest.raises(ValueError, match="share='vulkan': expected one of None, 'cuda', 'gl'"):
+        cltess.Session(tea_table, tessellator=tessellator, pixels=0.5, share="vulkan")
     frame = cltess.Session(tea_table, tessellator=tessellator, pixels=0.5).tessellate(camera=tea_table.camera)
     with pytest.raises(ValueError, match='share="cuda"'):
         frame.cuda()

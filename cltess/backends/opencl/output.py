@@ -256,6 +256,16 @@ class OutputBuffers:
             self._staging[name] = (buffer, array)
         return self._staging[name][1]
 
+    def close(self) -> None:
+        """Let the buffers go now (a later ``take`` makes new ones); earlier results are stale."""
+        self.generation += 1
+        self.unmap()
+        self._buffers.clear()
+        self._staging.clear()
+        self._field_buffers = {}
+        self._parent = None
+        self._capacity = (0, 0)
+
     @property
     def capacity(self) -> tuple[int, int]:
         """(vertices, triangles) the buffers hold now; (0, 0) before the first ``take``."""

@@ -248,8 +248,16 @@ class SharedAllocation:
             if fd.value >= 0:
                 os.close(fd.value)
             raise
-        self.pointer = pointer.value
+        self.pointer, self.handle = pointer.value, handle.value
         weakref.finalize(self, _free_allocation, cuda, queue, self.buffer, handle.value, self.pointer, self.nbytes)
+
+
+    def export_fd(self) -> int:
+        """A new file descriptor of this memory, for another importer (it takes it over)."""
+        fd = ctypes.c_int(-1)
+        self.cuda.call("cuMemExportToShareableHandle", ctypes.byref(fd), ctypes.c_uint64(self.handle),
+                       ctypes.c_int(CU_MEM_HANDLE_TYPE_POSIX_FILE_DESCRIPTOR), ctypes.c_uint64(0))
+        return fd.value
 
 
 class CudaArray:
@@ -284,14 +292,19 @@ class CudaArray:
         return f"CudaArray(shape={self.shape}, dtype={self.dtype}, pointer={self.pointer:#x})"
 
 
-class CudaArrays(dict):
-    """A frame's output as ``CudaArray``s: name -> array, also as attributes (``.positions``)."""
+class SharedFields(dict):
+    """A frame's output handed to another API: field name -> what that API holds it as, also
+    as attributes (``.positions``)."""
 
     def __getattr__(self, name):
         try:
             return self[name]
         except KeyError:
             raise AttributeError(name) from None
+
+
+class CudaArrays(SharedFields):
+    """A frame's output as ``CudaArray``s."""
 
 
 class CudaOutputBuffers(OutputBuffers):
@@ -316,7 +329,7 @@ class CudaOutputBuffers(OutputBuffers):
         return [self._buffers[name][0] for name, _, _ in self._layout()]
 
     def _hold(self) -> None:
-        if not self._held:
+        if not self._held and self._buffers:
             self.opencl.enqueue("Acquire", self.queue, self._field_list())
             self._held = True
 
@@ -329,6 +342,7 @@ class CudaOutputBuffers(OutputBuffers):
     def take(self, num_vertices: int, num_triangles: int):
         vertices, triangles = self._capacity
         if self._buffers and (num_vertices > vertices or num_triangles > triangles):
+            self._hold()  # (back from the API they were handed to: share_gl)
             self._let_go()
             self.queue.finish()  # nothing queued uses a buffer that growing replaces
         arrays = super().take(num_vertices, num_triangles)
@@ -338,6 +352,12 @@ class CudaOutputBuffers(OutputBuffers):
     def _enqueue_copies(self, num_vertices: int, num_triangles: int):
         self._hold()  # (after frame.cuda() handed them over)
         return super()._enqueue_copies(num_vertices, num_triangles)
+
+    def close(self) -> None:
+        self._let_go()
+        self.queue.finish()
+        self._allocations.clear()  # (freed once no frame's arrays hold them)
+        super().close()
 
     def share(self, num_vertices: int, num_triangles: int) -> CudaArrays:
         """The current output (this many vertices and triangles) handed to CUDA: the buffers
@@ -353,4 +373,4 @@ class CudaOutputBuffers(OutputBuffers):
         return arrays
 
 
-__all__ = ["CudaArray", "CudaArrays", "CudaOutputBuffers", "SharingUnavailable"]
+__all__ = ["CudaArray", "CudaArrays", "CudaOutputBuffers", "SharedFields", "SharingUnavailable"]

@@ -1,0 +1,8 @@
+# session 17, run 6: the GL descriptor test again (which descriptor stays)
+for f in .gl/*.deb; do dpkg -x $f /; done; ldconfig
+export __EGL_VENDOR_LIBRARY_FILENAMES=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json
+export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
+. bench/gpu_setup.sh
+CLTESS_DEVICE=nvidia timeout 300 python3 -m pytest -o addopts="" -q -p no:cacheprovider -W error::pytest.PytestUnraisableExceptionWarning \
+  tests/test_share_gl.py tests/test_share_cuda.py 2>&1 | tail -12 > $OUT/tests4.txt
+cat $OUT/tests4.txt
