@@ -113,6 +113,9 @@ def test_shared_memory_and_its_descriptors_go_with_the_session(sharing, tea_tabl
     session.tessellate().cuda()
     arrays = session.tessellate(eps=0.002).cuda()  # grown: the first allocations freed
     assert open_descriptors() > before  # (one exported fd per field's allocation, held by OpenCL)
+    session.close()  # the buffers go now (the arrays keep theirs); a later frame makes new ones
+    assert session.output.capacity == (0, 0)
+    assert_cuda_is(session.tessellate(eps=0.02).cuda(), sharing.tessellate(tea_table, eps=0.02))
     del session, arrays
     gc.collect()
     assert open_descriptors() == before

@@ -113,3 +113,16 @@ def test_closing_a_gl_session_frees_its_objects_and_descriptors(tessellator, hea
     kept = sorted(set(after.items()) - set(before.items()))
     assert set(before.items()) <= set(after.items()) and len(kept) <= 1, kept
     assert all(target == "/dev/nvidiactl" for _, target in kept), kept
+
+
+def test_two_buffer_sets_hand_overlapping_frames_to_gl(tessellator, headless_gl, tea_table):
+    cameras = list(orbit(tea_table, 4))
+    with cltess.Session(tea_table, tessellator=tessellator, pixels=0.5, share="gl", buffers=2) as session:
+        frames = []
+        for k, camera in enumerate(cameras):  # each enqueued while the one before may still run
+            frames.append(session.tessellate(camera=camera, wait=False))
+            if k >= 1:
+                expected = tessellator.tessellate(tea_table, request=session.request_for(cameras[k - 1]))
+                assert_gl_is(headless_gl, frames[k - 1].gl(), expected)
+        assert_gl_is(headless_gl, frames[-1].gl(),
+                     tessellator.tessellate(tea_table, request=session.request_for(cameras[-1])))
