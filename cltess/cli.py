@@ -407,6 +407,7 @@ def build_parser() -> argparse.ArgumentParser:
 def cmd_devices(args) -> int:
     """One line per platform, one per device under it with its probe verdict; '*' marks the
     default device."""
+    from cltess.backends.opencl.share_cuda import sharing_apis
     from cltess.device import DEVICE_ENV_VAR, DeviceError, default_device_info, list_devices, probe_device
 
     devices = list_devices()
@@ -430,8 +431,10 @@ def cmd_devices(args) -> int:
         marker = "*" if default is not None and info.device == default.device else " "
         memory_gib = info.global_memory_bytes / 2**30
         probe = probe_device(info)
+        shares = sharing_apis(info.device) if not isinstance(info.device, str) else []
         print(f"  {marker} {info.name}  [{info.type}]  {info.version}  "
-              f"{info.compute_units} compute units  {memory_gib:.1f} GiB  {probe.describe()}")
+              f"{info.compute_units} compute units  {memory_gib:.1f} GiB  {probe.describe()}"
+              + (f"  (Session(share=): {', '.join(shares)})" if shares else ""))
         if args.verbose and probe.log:
             print("      " + probe.log.strip().replace("\n", "\n      "))
     return EXIT_OK

@@ -119,3 +119,17 @@ def test_shared_memory_and_its_descriptors_go_with_the_session(sharing, tea_tabl
     del session, arrays
     gc.collect()
     assert open_descriptors() == before
+
+
+@pytest.mark.parametrize("cuda_part", range(len(NEEDED_EXTENSIONS) + 1))
+@pytest.mark.parametrize("gl_part", range(4))
+def test_the_apis_a_device_can_share_with_follow_its_extensions(cuda_part, gl_part):
+    from types import SimpleNamespace
+
+    from cltess.backends.opencl.share_cuda import sharing_apis
+    from cltess.backends.opencl.share_gl import NEEDED_CL_EXTENSIONS
+
+    extensions = ["cl_khr_fp64", *NEEDED_EXTENSIONS[:cuda_part], *NEEDED_CL_EXTENSIONS[:gl_part]]
+    cuda = cuda_part == len(NEEDED_EXTENSIONS)
+    expected = (["cuda", "gl"] if gl_part == len(NEEDED_CL_EXTENSIONS) else ["cuda"]) if cuda else []
+    assert sharing_apis(SimpleNamespace(extensions=" ".join(extensions))) == expected

@@ -53,6 +53,18 @@ CU_MEM_ALLOC_GRANULARITY_MINIMUM = 0
 NEEDED_EXTENSIONS = ("cl_khr_external_memory", "cl_khr_external_memory_opaque_fd", "cl_khr_device_uuid")
 
 
+def sharing_apis(device) -> list[str]:
+    """The APIs that ``Session(share=...)`` can hand this OpenCL device's output to, by its
+    extensions alone ("cuda": NEEDED_EXTENSIONS; "gl": those and share_gl.NEEDED_CL_EXTENSIONS).
+    The rest (libcuda, Vulkan, a current GL context) is checked when the Session is made."""
+    from .share_gl import NEEDED_CL_EXTENSIONS
+
+    extensions = set(device.extensions.split())
+    if not extensions.issuperset(NEEDED_EXTENSIONS):
+        return []
+    return ["cuda", "gl"] if extensions.issuperset(NEEDED_CL_EXTENSIONS) else ["cuda"]
+
+
 class SharingUnavailable(RuntimeError):
     """This device or machine cannot hand its output to the asked API without a copy."""
 
@@ -373,4 +385,4 @@ class CudaOutputBuffers(OutputBuffers):
         return arrays
 
 
-__all__ = ["CudaArray", "CudaArrays", "CudaOutputBuffers", "SharedFields", "SharingUnavailable"]
+__all__ = ["CudaArray", "CudaArrays", "CudaOutputBuffers", "SharedFields", "SharingUnavailable", "sharing_apis"]
