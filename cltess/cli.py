@@ -432,9 +432,9 @@ def cmd_devices(args) -> int:
         memory_gib = info.global_memory_bytes / 2**30
         probe = probe_device(info)
         shares = sharing_apis(info.device) if not isinstance(info.device, str) else []
+        shares_with = f"  shares with {', '.join(shares)}" if shares else ""  # Session(share=...)
         print(f"  {marker} {info.name}  [{info.type}]  {info.version}  "
-              f"{info.compute_units} compute units  {memory_gib:.1f} GiB  {probe.describe()}"
-              + (f"  (Session(share=): {', '.join(shares)})" if shares else ""))
+              f"{info.compute_units} compute units  {memory_gib:.1f} GiB{shares_with}  {probe.describe()}")
         if args.verbose and probe.log:
             print("      " + probe.log.strip().replace("\n", "\n      "))
     return EXIT_OK

@@ -18,6 +18,7 @@ import trimesh
 
 from cltess import cli
 from cltess.cli import main
+from cltess.backends.opencl.share_cuda import sharing_apis
 from cltess.device import DEVICE_ENV_VAR, list_devices
 from cltess.limits import OutputTooLarge
 from cltess.scene import Scene
@@ -133,6 +134,10 @@ def test_devices_lists_pocl_with_default_marker(capsys):
     device_lines = [line for line in out.splitlines() if line.startswith("  ")]
     assert sum(line.lstrip().startswith("*") for line in device_lines) == 1
     assert "CPU" in out
+    for info in list_devices():  # the APIs Session(share=...) can hand a device's output to
+        line = next(line for line in device_lines if f" {info.name}  [" in line)
+        apis = sharing_apis(info.device)
+        assert (f"  shares with {', '.join(apis)}  " in line) if apis else "shares with" not in line
 
 
 def test_devices_without_platform_exits_1_with_install_hint(capsys, monkeypatch):
