@@ -263,7 +263,6 @@ class SharedAllocation:
         self.pointer, self.handle = pointer.value, handle.value
         weakref.finalize(self, _free_allocation, cuda, queue, self.buffer, handle.value, self.pointer, self.nbytes)
 
-
     def export_fd(self) -> int:
         """A new file descriptor of this memory, for another importer (it takes it over)."""
         fd = ctypes.c_int(-1)

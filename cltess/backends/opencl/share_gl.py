@@ -8,8 +8,8 @@ exports, imported by OpenCL (``cl_khr_external_memory``) and by GL (``GL_EXT_mem
 ``glImportMemoryFdEXT``, ``glNamedBufferStorageMemEXT``).  GL sees another API's writes only
 after a ``glWaitSemaphoreEXT`` naming the buffers, on a semaphore that the writer signals, and
 neither OpenCL nor CUDA nor GL exports one there; Vulkan does.  So a small Vulkan device on the
-same GPU (matched by UUID) makes two binary semaphores and exports each as an opaque fd, which
-OpenCL (``cl_khr_external_semaphore_opaque_fd``) and GL (``GL_EXT_semaphore_fd``) import:
+same GPU (matched by UUID) makes two binary semaphores and exports each twice as an opaque fd,
+once for OpenCL (``cl_khr_external_semaphore_opaque_fd``) and once for GL (``GL_EXT_semaphore_fd``):
 
 * ``ready``: ``frame.gl()`` enqueues OpenCL's release of the buffers and a signal of ``ready``,
   and has GL wait for it (``glWaitSemaphoreEXT`` with the buffers): GL's commands after the call
@@ -36,7 +36,6 @@ from .share_cuda import CudaOutputBuffers, SharedFields, SharingUnavailable
 CL_SEMAPHORE_TYPE_KHR = 0x203D
 CL_SEMAPHORE_TYPE_BINARY_KHR = 1
 CL_SEMAPHORE_HANDLE_OPAQUE_FD_KHR = 0x2055
-CL_DEVICE_SEMAPHORE_IMPORT_HANDLE_TYPES_KHR = 0x204D
 # GL_EXT_memory_object_fd, GL_EXT_semaphore_fd
 GL_HANDLE_TYPE_OPAQUE_FD_EXT = 0x9586
 GL_NUM_EXTENSIONS = 0x821D
