@@ -287,9 +287,9 @@ ALWAYS_INLINE void kind_row_next(__private const kind_patch *patch, __private ki
  * (kind_eval).  Each lane is computed with float8 arithmetic, component by component the same
  * operations in the same order as the scalar functions (FP_CONTRACT is off: common.h), and the
  * builtins in the runtime's own forms (common.h lanes_cross_term, lanes_dot, lanes_length), so
- * the same bits.  Two shortcuts of projected and unit_or give the same bits without their branch:
- * h.xyz / h.w where h.w is 1 is h.xyz (projected's comment), and a zero component divided by
- * len > 0 is itself (unit_or's).  A lane whose t_u x t_v is (nearly) vanishing, or whose length
+ * the same bits.  unit_or's shortcut gives the same bits without its branch (a zero component
+ * divided by len > 0 is itself); projected's (h.xyz / h.w where h.w is 1 is h.xyz) is taken where
+ * every lane's h.w is 1.  A lane whose t_u x t_v is (nearly) vanishing, or whose length
  * is not its plain value (lanes_length_plain: PoCL's scaled branches) or not positive, is not
  * "plain": stages/rows.h then makes the eight points one by one by the scalar functions
  * (put_row_lanes, put_ring_lanes).  The kind's side of the contract: KIND_LANES,
@@ -353,7 +353,16 @@ ALWAYS_INLINE void surface_eval_lanes(const float4 b[16], float8 u, float8 v, fl
 ALWAYS_INLINE void normal_lanes(const float8 s[4], const float8 s_u[4], const float8 s_v[4], float8 p[3],
                                 float8 normal[3], __private int8 *plain)
 {
-    float8 px = s[0] / s[3], py = s[1] / s[3], pz = s[2] / s[3];
+    /* projected's shortcut where every lane's h.w is 1 (polynomial patches): h.xyz / 1 is h.xyz, and
+     * three divisions fewer for the divider that the normal's sqrt and divisions keep busy (Intel's
+     * runtime 88-89 -> 86, PoCL 93-95 -> 91-92 CPU ms of stage 4 on uniform level 16: bench/RESULTS.md,
+     * "Session 17, lead") */
+    float8 px = s[0], py = s[1], pz = s[2];
+    if (!every_lane(s[3] == 1.0f)) {
+        px = s[0] / s[3];
+        py = s[1] / s[3];
+        pz = s[2] / s[3];
+    }
     p[0] = px;
     p[1] = py;
     p[2] = pz;
