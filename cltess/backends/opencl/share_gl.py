@@ -26,6 +26,7 @@ the buffers.  GL calls need the session's GL context current on the calling thre
 from __future__ import annotations
 
 import ctypes
+import os
 
 import numpy as np
 import pyopencl as cl
@@ -373,9 +374,14 @@ class GlOutputBuffers(CudaOutputBuffers):
         self._delete_gl(name)
         buffer = super()._new_buffer(name, nbytes)
         allocation = self._allocations[name]
-        memory, gl_buffer = _u32(), _u32()
+        memory, gl_buffer, fd = _u32(), _u32(), allocation.export_fd()
         self.gl.glCreateMemoryObjectsEXT(1, ctypes.byref(memory))
-        self.gl.glImportMemoryFdEXT(memory, allocation.nbytes, GL_HANDLE_TYPE_OPAQUE_FD_EXT, allocation.export_fd())
+        self.gl.glImportMemoryFdEXT(memory, allocation.nbytes, GL_HANDLE_TYPE_OPAQUE_FD_EXT, fd)
+        error = self.gl.glGetError()
+        if error:  # (GL takes the fd over only when the import succeeds)
+            os.close(fd)
+            self.gl.glDeleteMemoryObjectsEXT(1, ctypes.byref(memory))
+            raise RuntimeError(f"OpenGL error {error:#x} importing {name}'s memory (glImportMemoryFdEXT)")
         self.gl.glCreateBuffers(1, ctypes.byref(gl_buffer))
         self.gl.glNamedBufferStorageMemEXT(gl_buffer, allocation.nbytes, memory, 0)
         self._gl_objects[name] = (memory.value, gl_buffer.value)
