@@ -40,9 +40,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 
 import cltess  # noqa: E402
 from cltess.backends.opencl import Tessellator  # noqa: E402
-from cltess.tessellation import HOST_FIELDS  # noqa: E402
+from cltess.backends.opencl.output import OutputBuffers  # noqa: E402
 
-FIELDS = [name for name in HOST_FIELDS if name not in ("factors", "real_factors")]
+FIELDS = list(OutputBuffers.FIELDS)  # the output buffers: the vertex record and the triangles
 
 
 def timed(call):

@@ -7,16 +7,17 @@ import numpy as np
 import pytest
 
 import cltess
-from cltess.backends.opencl.share_cuda import NEEDED_EXTENSIONS, SharingUnavailable
-from cltess.tessellation import HOST_FIELDS, StaleOutput
+from cltess.backends.opencl.output import OutputBuffers
+from cltess.backends.opencl.share_cuda import NEEDED_EXTENSIONS, SharingUnavailable, sharing_apis
+from cltess.tessellation import StaleOutput
 from support import assert_same_output
 from test_session import orbit
 
-FIELDS = [name for name in HOST_FIELDS if name not in ("factors", "real_factors")]
+FIELDS = list(OutputBuffers.FIELDS)  # the output buffers: the vertex record and the triangles
 
 
 def offers_sharing(tessellator) -> bool:
-    return all(name in tessellator.device.extensions.split() for name in NEEDED_EXTENSIONS)
+    return "cuda" in sharing_apis(tessellator.device)
 
 
 @pytest.fixture
@@ -126,7 +127,6 @@ def test_shared_memory_and_its_descriptors_go_with_the_session(sharing, tea_tabl
 def test_the_apis_a_device_can_share_with_follow_its_extensions(cuda_part, gl_part):
     from types import SimpleNamespace
 
-    from cltess.backends.opencl.share_cuda import sharing_apis
     from cltess.backends.opencl.share_gl import NEEDED_CL_EXTENSIONS
 
     extensions = ["cl_khr_fp64", *NEEDED_EXTENSIONS[:cuda_part], *NEEDED_CL_EXTENSIONS[:gl_part]]

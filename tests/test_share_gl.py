@@ -10,18 +10,17 @@ import os
 import pytest
 
 import cltess
-from cltess.backends.opencl.share_cuda import NEEDED_EXTENSIONS, SharingUnavailable
-from cltess.backends.opencl.share_gl import NEEDED_CL_EXTENSIONS
-from cltess.tessellation import HOST_FIELDS, StaleOutput
+from cltess.backends.opencl.output import OutputBuffers
+from cltess.backends.opencl.share_cuda import SharingUnavailable, sharing_apis
+from cltess.tessellation import StaleOutput
 from test_session import orbit
 
-FIELDS = [name for name in HOST_FIELDS if name not in ("factors", "real_factors")]
+FIELDS = list(OutputBuffers.FIELDS)  # the output buffers: the vertex record and the triangles
 
 
 @pytest.fixture
 def headless_gl(tessellator):
-    extensions = tessellator.device.extensions.split()
-    if not all(name in extensions for name in NEEDED_EXTENSIONS + NEEDED_CL_EXTENSIONS):
+    if "gl" not in sharing_apis(tessellator.device):
         pytest.skip(f"{tessellator.device.name.strip()} cannot share with GL")
     from support.egl import HeadlessGL
     try:

@@ -179,15 +179,17 @@ class OpenCLExternalMemory:
                                                      ctypes.POINTER(ctypes.c_int)]
         lib.clGetExtensionFunctionAddressForPlatform.restype = ctypes.c_void_p
         lib.clGetExtensionFunctionAddressForPlatform.argtypes = [ctypes.c_void_p, ctypes.c_char_p]
-        enqueue = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_uint, ctypes.POINTER(ctypes.c_void_p),
-                                   ctypes.c_uint, ctypes.c_void_p, ctypes.POINTER(ctypes.c_void_p))
-        self._enqueue = {}
-        for command in ("Acquire", "Release"):
-            name = f"clEnqueue{command}ExternalMemObjectsKHR"
-            address = lib.clGetExtensionFunctionAddressForPlatform(device.platform.int_ptr, name.encode())
-            if not address:
-                raise SharingUnavailable(f"{device.platform.name.strip()}: no {name}")
-            self._enqueue[command] = enqueue(address)
+        enqueue = (ctypes.c_int, ctypes.c_void_p, ctypes.c_uint, ctypes.POINTER(ctypes.c_void_p), ctypes.c_uint,
+                   ctypes.c_void_p, ctypes.POINTER(ctypes.c_void_p))
+        self._enqueue = {command: self.extension_function(f"clEnqueue{command}ExternalMemObjectsKHR", *enqueue)
+                         for command in ("Acquire", "Release")}
+
+    def extension_function(self, name: str, restype, *argtypes):
+        """The device's platform's extension function ``name``, typed."""
+        address = self.lib.clGetExtensionFunctionAddressForPlatform(self.device.platform.int_ptr, name.encode())
+        if not address:
+            raise SharingUnavailable(f"{self.device.platform.name.strip()}: no {name}")
+        return ctypes.CFUNCTYPE(restype, *argtypes)(address)
 
     def import_fd(self, fd: int, nbytes: int) -> cl.Buffer:
         """An OpenCL buffer on the memory behind ``fd``, which OpenCL then owns: NVIDIA's
@@ -212,6 +214,14 @@ class OpenCLExternalMemory:
         return cl.Event.from_int_ptr(event.value, retain=False)
 
 
+def _free_cuda_memory(cuda: _Cuda, handle: int, pointer: int, nbytes: int) -> None:
+    """Unmap, unreserve and release what SharedAllocation made (pointer 0: not reserved yet)."""
+    if pointer:
+        cuda.current("cuMemUnmap", ctypes.c_uint64(pointer), ctypes.c_size_t(nbytes))
+        cuda.call("cuMemAddressFree", ctypes.c_uint64(pointer), ctypes.c_size_t(nbytes))
+    cuda.call("cuMemRelease", ctypes.c_uint64(handle))
+
+
 def _free_allocation(cuda: _Cuda, queue: cl.CommandQueue, buffer: cl.Buffer, handle: int, pointer: int,
                      nbytes: int) -> None:
     """A SharedAllocation's end: nothing queued may still use it; OpenCL's buffer goes first
@@ -221,9 +231,7 @@ def _free_allocation(cuda: _Cuda, queue: cl.CommandQueue, buffer: cl.Buffer, han
         buffer.release()
     except cl.Error:  # (the context is gone at interpreter exit: nothing is queued then)
         pass
-    cuda.current("cuMemUnmap", ctypes.c_uint64(pointer), ctypes.c_size_t(nbytes))
-    cuda.call("cuMemAddressFree", ctypes.c_uint64(pointer), ctypes.c_size_t(nbytes))
-    cuda.call("cuMemRelease", ctypes.c_uint64(handle))
+    _free_cuda_memory(cuda, handle, pointer, nbytes)
 
 
 class SharedAllocation:
@@ -253,10 +261,10 @@ class SharedAllocation:
                          ctypes.c_size_t(1))
             self.buffer = opencl.import_fd(fd.value, self.nbytes)
         except Exception:
-            if pointer.value:
-                cuda.lib.cuMemUnmap(pointer, ctypes.c_size_t(self.nbytes))
-                cuda.lib.cuMemAddressFree(pointer, ctypes.c_size_t(self.nbytes))
-            cuda.lib.cuMemRelease(handle)
+            try:
+                _free_cuda_memory(cuda, handle.value, pointer.value, self.nbytes)
+            except RuntimeError:  # (the first failure is the one to report)
+                pass
             if fd.value >= 0:
                 os.close(fd.value)
             raise
@@ -339,7 +347,12 @@ class CudaOutputBuffers(OutputBuffers):
     def _field_list(self) -> list:
         return [self._buffers[name][0] for name, _, _ in self._layout()]
 
+    def _reclaim(self) -> None:
+        """Take the buffers back from the API they were handed to: nothing here, frame.cuda()
+        waited for the release (share_gl's GL has to signal first)."""
+
     def _hold(self) -> None:
+        self._reclaim()
         if not self._held and self._buffers:
             self.opencl.enqueue("Acquire", self.queue, self._field_list())
             self._held = True
@@ -353,7 +366,7 @@ class CudaOutputBuffers(OutputBuffers):
     def take(self, num_vertices: int, num_triangles: int):
         vertices, triangles = self._capacity
         if self._buffers and (num_vertices > vertices or num_triangles > triangles):
-            self._hold()  # (back from the API they were handed to: share_gl)
+            self._reclaim()
             self._let_go()
             self.queue.finish()  # nothing queued uses a buffer that growing replaces
         arrays = super().take(num_vertices, num_triangles)

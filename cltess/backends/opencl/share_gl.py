@@ -284,14 +284,7 @@ class _OpenCLSemaphores:
         if missing:
             raise SharingUnavailable(f"{device.name.strip()}: share=\"gl\" needs the OpenCL extensions "
                                      f"{', '.join(missing)}, which this device does not offer")
-        lib, platform = opencl.lib, device.platform.int_ptr
-
-        def function(name, restype, *argtypes):
-            address = lib.clGetExtensionFunctionAddressForPlatform(platform, name.encode())
-            if not address:
-                raise SharingUnavailable(f"{device.platform.name.strip()}: no {name}")
-            return ctypes.CFUNCTYPE(restype, *argtypes)(address)
-
+        function = opencl.extension_function
         self.context, self.device = opencl.context, device
         self._create = function("clCreateSemaphoreWithPropertiesKHR", _ptr, _ptr, ctypes.POINTER(_u64),
                                 ctypes.POINTER(ctypes.c_int))
@@ -397,7 +390,7 @@ class GlOutputBuffers(CudaOutputBuffers):
     def _gl_buffer_list(self) -> ctypes.Array:
         return (_u32 * len(self._gl_objects))(*(gl_buffer for _, gl_buffer in self._gl_objects.values()))
 
-    def _hold(self) -> None:
+    def _reclaim(self) -> None:
         if self._with_gl and self._buffers:  # GL gives the buffers back after the commands it has: done
             self.gl.check("taking the buffers back from OpenGL")
             buffers = self._gl_buffer_list()
@@ -405,7 +398,6 @@ class GlOutputBuffers(CudaOutputBuffers):
             self.gl.glFlush()
             self.cl_semaphores.enqueue("wait", self.queue, self._cl_semaphore["done"])
             self._with_gl = False
-        super()._hold()
 
     def share(self, num_vertices: int, num_triangles: int) -> GlBuffers:
         """The current output handed to GL: released by OpenCL, ``ready`` signalled behind it
@@ -436,7 +428,7 @@ class GlOutputBuffers(CudaOutputBuffers):
         if not self._gl_semaphore:  # (closed already)
             return
         self.gl.check("closing the shared buffers")
-        self._hold()  # (GL's commands on them done before OpenCL's wait ends)
+        self._reclaim()  # (GL's commands on them done before OpenCL's wait ends)
         self.queue.finish()
         for name in list(self._gl_objects):
             self._delete_gl(name)
