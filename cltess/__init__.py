@@ -37,6 +37,9 @@ def __getattr__(name):
     if name == "Session":
         from .session import Session
         return Session
+    if name == "VulkanQueue":  # Session(share="vulkan", vulkan=VulkanQueue(...))
+        from .backends.opencl.share_vulkan import VulkanQueue
+        return VulkanQueue
     if name == "load_scene":
         from .io import load_scene
         return load_scene
@@ -44,4 +47,4 @@ def __getattr__(name):
 
 
 __all__ = ["__version__", "Camera", "Request", "Scene", "SceneError", "Tessellation", "Tessellator", "Session",
-           "load_scene", "export"]
+           "VulkanQueue", "load_scene", "export"]

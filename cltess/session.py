@@ -64,8 +64,13 @@ def _gl_outputs():
     return GlOutputBuffers
 
 
+def _vulkan_outputs():
+    from .backends.opencl.share_vulkan import VulkanOutputBuffers
+    return VulkanOutputBuffers
+
+
 #: Session(share=...): the output buffers' class, by the API the output is handed to.
-SHARED_OUTPUTS = {None: lambda: OutputBuffers, "cuda": _cuda_outputs, "gl": _gl_outputs}
+SHARED_OUTPUTS = {None: lambda: OutputBuffers, "cuda": _cuda_outputs, "gl": _gl_outputs, "vulkan": _vulkan_outputs}
 
 
 @dataclass
@@ -90,22 +95,28 @@ class Session:
     frame's output stays valid while the next frame computes.  share: "cuda" to hand each
     frame's output to CUDA without a copy (``frame.cuda()``; an NVIDIA device:
     backends/opencl/share_cuda.py), "gl" to OpenGL (``frame.gl()``; made, used and closed with
-    the GL context current: backends/opencl/share_gl.py), else None.  ``close()`` (or a
-    ``with`` block) lets the buffers go at once.
+    the GL context current: backends/opencl/share_gl.py), "vulkan" to the Vulkan device and
+    queue named by ``vulkan`` (a ``VulkanQueue``; ``frame.vulkan()``:
+    backends/opencl/share_vulkan.py), else None.  ``close()`` (or a ``with`` block) lets the
+    buffers go at once.
     """
 
     def __init__(self, scene: Scene, device=None, request: Request | None = None,
-                 tessellator: Tessellator | None = None, buffers: int = 1, share: str | None = None, **options):
+                 tessellator: Tessellator | None = None, buffers: int = 1, share: str | None = None,
+                 vulkan=None, **options):
         if isinstance(buffers, bool) or not isinstance(buffers, int) or buffers < 1:
             raise ValueError(f"buffers must be a whole number >= 1, got {buffers!r}")
         if share not in SHARED_OUTPUTS:
             raise ValueError(f"share={share!r}: expected one of {', '.join(map(repr, SHARED_OUTPUTS))}")
+        if (vulkan is not None) != (share == "vulkan"):
+            raise ValueError("vulkan=VulkanQueue(...) goes with share=\"vulkan\", and only with it")
         self.tessellator = tessellator if tessellator is not None else Tessellator(device)
         self.scene = scene
         self.request = request if request is not None else Request.of(**options)
         self.request.check(scene)
         outputs = SHARED_OUTPUTS[share]()
-        self._sets = [FrameBuffers(outputs(self.tessellator, pinned=True)) for _ in range(buffers)]
+        where = {"vulkan": vulkan} if share == "vulkan" else {}
+        self._sets = [FrameBuffers(outputs(self.tessellator, pinned=True, **where)) for _ in range(buffers)]
         self._current = self._sets[0]  # the set of the latest frame (the next frame's before the first)
         self._scene_data: dict = {}  # sharp_edges -> SceneData
         self.frames = 0
@@ -254,7 +265,8 @@ class Session:
     def close(self) -> None:
         """Let the output buffers go now; the session's frames are stale, and a later frame
         makes new ones.  With share="gl": the GL objects are deleted (the session's GL context
-        current), and the session makes no more frames."""
+        current), with share="vulkan" the objects made in the caller's device (before that device
+        is destroyed), and the session makes no more frames."""
         for buffers in self._sets:
             buffers.output.close()
             buffers.recorded = None  # (its launches name the buffers let go)

@@ -50,7 +50,7 @@ class DeviceOutput:
     before the arrays or sizes are first given, for an output whose size the host learns late
     (a Session frame, launched before stage 3's totals were read back); share: hands the
     buffers to the API named by ``shares`` and returns its arrays (a Session made with
-    ``share="cuda"`` or ``"gl"``), else None.
+    ``share="cuda"``, ``"gl"`` or ``"vulkan"``), else None.
     """
 
     arrays: dict
@@ -222,6 +222,15 @@ class Tessellation(IndexedMesh):
         waits on the device; the host does not).  Valid until the session's next ``tessellate``
         call: issue the commands that use them before it."""
         return self._shared("gl")
+
+    def vulkan(self):
+        """The output as ``VkBuffer``s of the Session's Vulkan device, no copy
+        (``share_vulkan.VulkanBuffers``: each field's buffer and memory handles, rows and
+        components) for a frame of ``Session(..., share="vulkan", vulkan=VulkanQueue(...))``;
+        commands submitted to that queue after the call see the frame (the queue waits on the
+        device; the host does not).  Valid until the session's next ``tessellate`` call: submit
+        the commands that use them before it."""
+        return self._shared("vulkan")
 
     def _shared(self, api: str):
         device = self.__dict__.get("device")

@@ -43,8 +43,8 @@ def test_a_device_without_external_memory_refuses_to_share(tessellator, tea_tabl
 
 
 def test_a_session_refuses_an_api_it_cannot_hand_to(tessellator, tea_table):
-    with pytest.raises(ValueError, match="share='vulkan': expected one of None, 'cuda', 'gl'"):
-        cltess.Session(tea_table, tessellator=tessellator, pixels=0.5, share="vulkan")
+    with pytest.raises(ValueError, match="share='metal': expected one of None, 'cuda', 'gl', 'vulkan'"):
+        cltess.Session(tea_table, tessellator=tessellator, pixels=0.5, share="metal")
     frame = cltess.Session(tea_table, tessellator=tessellator, pixels=0.5).tessellate(camera=tea_table.camera)
     with pytest.raises(ValueError, match='share="cuda"'):
         frame.cuda()
@@ -131,5 +131,5 @@ def test_the_apis_a_device_can_share_with_follow_its_extensions(cuda_part, gl_pa
 
     extensions = ["cl_khr_fp64", *NEEDED_EXTENSIONS[:cuda_part], *NEEDED_CL_EXTENSIONS[:gl_part]]
     cuda = cuda_part == len(NEEDED_EXTENSIONS)
-    expected = (["cuda", "gl"] if gl_part == len(NEEDED_CL_EXTENSIONS) else ["cuda"]) if cuda else []
+    expected = (["cuda", "gl", "vulkan"] if gl_part == len(NEEDED_CL_EXTENSIONS) else ["cuda"]) if cuda else []
     assert sharing_apis(SimpleNamespace(extensions=" ".join(extensions))) == expected

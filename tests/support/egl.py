@@ -1,7 +1,7 @@
 """A headless OpenGL 4.5 context through EGL (the device platform: no display), made current
 on this thread, and reading a GL buffer back, for share="gl" (cltess/backends/opencl/share_gl.py)
-in tests/test_share_gl.py and bench/gpu_share.py.  On the lent GPU machine EGL and GL come from
-the .deb packages its README names (libegl1, libopengl0, ...)."""
+in tests/test_share_handover.py and bench/gpu_share.py.  On the lent GPU machine EGL and GL come
+from the .deb packages its README names (libegl1, libopengl0, ...)."""
 from __future__ import annotations
 
 import ctypes

@@ -55,14 +55,15 @@ NEEDED_EXTENSIONS = ("cl_khr_external_memory", "cl_khr_external_memory_opaque_fd
 
 def sharing_apis(device) -> list[str]:
     """The APIs that ``Session(share=...)`` can hand this OpenCL device's output to, by its
-    extensions alone ("cuda": NEEDED_EXTENSIONS; "gl": those and share_gl.NEEDED_CL_EXTENSIONS).
-    The rest (libcuda, Vulkan, a current GL context) is checked when the Session is made."""
+    extensions alone ("cuda": NEEDED_EXTENSIONS; "gl" and "vulkan": those and
+    share_gl.NEEDED_CL_EXTENSIONS, the semaphores).  The rest (libcuda, the Vulkan loader, a
+    current GL context, the caller's Vulkan device) is checked when the Session is made."""
     from .share_gl import NEEDED_CL_EXTENSIONS
 
     extensions = set(device.extensions.split())
     if not extensions.issuperset(NEEDED_EXTENSIONS):
         return []
-    return ["cuda", "gl"] if extensions.issuperset(NEEDED_CL_EXTENSIONS) else ["cuda"]
+    return ["cuda", "gl", "vulkan"] if extensions.issuperset(NEEDED_CL_EXTENSIONS) else ["cuda"]
 
 
 class SharingUnavailable(RuntimeError):
@@ -390,11 +391,21 @@ class CudaOutputBuffers(OutputBuffers):
         released = self._let_go()
         if released is not None:
             released.wait()
-        arrays = CudaArrays()
+        return self._shared_fields(CudaArrays(), num_vertices, num_triangles,
+                                   lambda name, rows, shape, dtype: CudaArray(self._allocations[name], (rows, *shape),
+                                                                              dtype))
+
+    def _shared_fields(self, fields: SharedFields, num_vertices: int, num_triangles: int, make) -> SharedFields:
+        """``fields`` filled with ``make(name, rows, shape, dtype)`` of each output field, rows
+        being the frame's vertices or triangles."""
         for name, dtype, shape in self._layout():
-            rows = num_triangles if name == "triangles" else num_vertices
-            arrays[name] = CudaArray(self._allocations[name], (rows, *shape), dtype)
-        return arrays
+            fields[name] = make(name, num_triangles if name == "triangles" else num_vertices, shape, dtype)
+        return fields
+
+    def _check_open(self, still_open) -> None:
+        """Refuse a frame after close() (``still_open``: what close() empties)."""
+        if not still_open:
+            raise RuntimeError(f"this share=\"{self.shares}\" Session was closed: make a new one")
 
 
 __all__ = ["CudaArray", "CudaArrays", "CudaOutputBuffers", "SharedFields", "SharingUnavailable", "sharing_apis"]

@@ -9,7 +9,8 @@ exports, imported by OpenCL (``cl_khr_external_memory``) and by GL (``GL_EXT_mem
 after a ``glWaitSemaphoreEXT`` naming the buffers, on a semaphore that the writer signals, and
 neither OpenCL nor CUDA nor GL exports one there; Vulkan does.  So a small Vulkan device on the
 same GPU (matched by UUID) makes two binary semaphores and exports each twice as an opaque fd,
-once for OpenCL (``cl_khr_external_semaphore_opaque_fd``) and once for GL (``GL_EXT_semaphore_fd``):
+once for OpenCL (``cl_khr_external_semaphore_opaque_fd``; OpenCL's imports are kept per context
+and lent to one session at a time: ``OpenCLSemaphores``) and once for GL (``GL_EXT_semaphore_fd``):
 
 * ``ready``: ``frame.gl()`` enqueues OpenCL's release of the buffers and a signal of ``ready``,
   and has GL wait for it (``glWaitSemaphoreEXT`` with the buffers): GL's commands after the call
@@ -32,6 +33,7 @@ import numpy as np
 import pyopencl as cl
 
 from .share_cuda import CudaOutputBuffers, SharedFields, SharingUnavailable
+from .vulkan import ExportableSemaphores, VulkanDevice
 
 # cl_khr_semaphore, cl_khr_external_semaphore (cl_ext.h)
 CL_SEMAPHORE_TYPE_KHR = 0x203D
@@ -41,18 +43,6 @@ CL_SEMAPHORE_HANDLE_OPAQUE_FD_KHR = 0x2055
 GL_HANDLE_TYPE_OPAQUE_FD_EXT = 0x9586
 GL_NUM_EXTENSIONS = 0x821D
 GL_EXTENSIONS = 0x1F03
-# Vulkan 1.1 (vulkan_core.h)
-VK_API_VERSION_1_1 = (1 << 22) | (1 << 12)
-VK_STRUCTURE_TYPE_APPLICATION_INFO = 0
-VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO = 1
-VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO = 2
-VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO = 3
-VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO = 9
-VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2 = 1000059001
-VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ID_PROPERTIES = 1000071004
-VK_STRUCTURE_TYPE_EXPORT_SEMAPHORE_CREATE_INFO = 1000077000
-VK_STRUCTURE_TYPE_SEMAPHORE_GET_FD_INFO_KHR = 1000079001
-VK_EXTERNAL_SEMAPHORE_HANDLE_TYPE_OPAQUE_FD_BIT = 0x1
 
 #: What share="gl" needs beyond share="cuda": the OpenCL and GL extensions.
 NEEDED_CL_EXTENSIONS = ("cl_khr_semaphore", "cl_khr_external_semaphore", "cl_khr_external_semaphore_opaque_fd")
@@ -128,161 +118,38 @@ class _CurrentGL:
             raise RuntimeError(f"OpenGL error {error:#x} in {doing}")
 
 
-class _VkStruct(ctypes.Structure):
-    pass
-
-
-class _ApplicationInfo(_VkStruct):
-    _fields_ = [("sType", _u32), ("pNext", _ptr), ("pApplicationName", ctypes.c_char_p), ("applicationVersion", _u32),
-                ("pEngineName", ctypes.c_char_p), ("engineVersion", _u32), ("apiVersion", _u32)]
-
-
-class _InstanceCreateInfo(_VkStruct):
-    _fields_ = [("sType", _u32), ("pNext", _ptr), ("flags", _u32), ("pApplicationInfo", _ptr),
-                ("enabledLayerCount", _u32), ("ppEnabledLayerNames", _ptr), ("enabledExtensionCount", _u32),
-                ("ppEnabledExtensionNames", _ptr)]
-
-
-class _PhysicalDeviceIDProperties(_VkStruct):
-    _fields_ = [("sType", _u32), ("pNext", _ptr), ("deviceUUID", ctypes.c_ubyte * 16),
-                ("driverUUID", ctypes.c_ubyte * 16), ("deviceLUID", ctypes.c_ubyte * 8), ("deviceNodeMask", _u32),
-                ("deviceLUIDValid", _u32)]
-
-
-class _PhysicalDeviceProperties2(_VkStruct):  # the properties themselves as room enough (824 bytes in 1.1)
-    _fields_ = [("sType", _u32), ("pNext", _ptr), ("properties", ctypes.c_ubyte * 2048)]
-
-
-class _DeviceQueueCreateInfo(_VkStruct):
-    _fields_ = [("sType", _u32), ("pNext", _ptr), ("flags", _u32), ("queueFamilyIndex", _u32), ("queueCount", _u32),
-                ("pQueuePriorities", ctypes.POINTER(ctypes.c_float))]
-
-
-class _DeviceCreateInfo(_VkStruct):
-    _fields_ = [("sType", _u32), ("pNext", _ptr), ("flags", _u32), ("queueCreateInfoCount", _u32),
-                ("pQueueCreateInfos", _ptr), ("enabledLayerCount", _u32), ("ppEnabledLayerNames", _ptr),
-                ("enabledExtensionCount", _u32), ("ppEnabledExtensionNames", _ptr), ("pEnabledFeatures", _ptr)]
-
-
-class _ExportSemaphoreCreateInfo(_VkStruct):
-    _fields_ = [("sType", _u32), ("pNext", _ptr), ("handleTypes", _u32)]
-
-
-class _SemaphoreCreateInfo(_VkStruct):
-    _fields_ = [("sType", _u32), ("pNext", _ptr), ("flags", _u32)]
-
-
-class _SemaphoreGetFdInfo(_VkStruct):
-    _fields_ = [("sType", _u32), ("pNext", _ptr), ("semaphore", _u64), ("handleType", _u32)]
-
-
-class _VulkanSemaphores:
-    """A Vulkan 1.1 device on the GPU with this UUID, only to make binary semaphores exportable
-    as opaque fds (VK_KHR_external_semaphore_fd); it runs no work.  One per GPU for the process
-    (``for_uuid``), never destroyed: on the H200 (driver 580) ``vkDestroyInstance`` left the
-    thread with no current GL context (bench/RESULTS.md, "Session 17, lead")."""
+class _VulkanSemaphores(ExportableSemaphores):
+    """A Vulkan device on the GPU with this UUID (vulkan.py), only to make binary semaphores
+    exportable as opaque fds; it runs no work.  One per GPU for the process (``for_uuid``),
+    never destroyed: on the H200 (driver 580) ``vkDestroyInstance`` left the thread with no
+    current GL context (bench/RESULTS.md, "Session 17, lead")."""
 
     _made: dict = {}  # uuid -> the one of that GPU
 
     @classmethod
-    def for_uuid(cls, uuid: bytes) -> "_VulkanSemaphores":
+    def for_uuid(cls, uuid: bytes, api: str) -> "_VulkanSemaphores":
         if uuid not in cls._made:
-            cls._made[uuid] = cls(uuid)
+            device = VulkanDevice(uuid, ("VK_KHR_external_semaphore_fd",), api=api)
+            cls._made[uuid] = cls(device.vk, device.device)
         return cls._made[uuid]
 
-    def __init__(self, uuid: bytes):
-        try:
-            vk = self.vk = ctypes.CDLL("libvulkan.so.1")
-        except OSError as error:
-            raise SharingUnavailable(f"share=\"gl\" needs the Vulkan loader libvulkan.so.1 (for its semaphores): "
-                                     f"{error}") from None
-        # (every handle typed: an untyped Python int is passed as a 32-bit int, a truncated pointer)
-        vk.vkGetInstanceProcAddr.restype, vk.vkGetInstanceProcAddr.argtypes = _ptr, [_ptr, ctypes.c_char_p]
-        vk.vkCreateInstance.argtypes = [_ptr, _ptr, ctypes.POINTER(_ptr)]
-        vk.vkEnumeratePhysicalDevices.argtypes = [_ptr, ctypes.POINTER(_u32), _ptr]
-        vk.vkCreateDevice.argtypes = [_ptr, _ptr, _ptr, ctypes.POINTER(_ptr)]
-        vk.vkCreateSemaphore.argtypes = [_ptr, _ptr, _ptr, ctypes.POINTER(_u64)]
-        vk.vkDestroySemaphore.argtypes = [_ptr, _u64, _ptr]
-        vk.vkDestroyInstance.argtypes = [_ptr, _ptr]
-        application = _ApplicationInfo(VK_STRUCTURE_TYPE_APPLICATION_INFO, None, b"cltess", 1, b"cltess", 1,
-                                       VK_API_VERSION_1_1)
-        create = _InstanceCreateInfo(VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO, None, 0,
-                                     ctypes.cast(ctypes.pointer(application), _ptr), 0, None, 0, None)
-        self.instance = _ptr()
-        self._check("vkCreateInstance", vk.vkCreateInstance(ctypes.byref(create), None, ctypes.byref(self.instance)))
-        count = _u32()
-        vk.vkEnumeratePhysicalDevices(self.instance, ctypes.byref(count), None)
-        physical = (_ptr * count.value)()
-        vk.vkEnumeratePhysicalDevices(self.instance, ctypes.byref(count), physical)
-        properties2 = self._instance_function("vkGetPhysicalDeviceProperties2", None, _ptr, _ptr)
-        chosen = None
-        for device in physical:
-            ids = _PhysicalDeviceIDProperties(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ID_PROPERTIES, None)
-            wanted = _PhysicalDeviceProperties2(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2,
-                                                ctypes.cast(ctypes.pointer(ids), _ptr))
-            properties2(device, ctypes.byref(wanted))
-            if bytes(ids.deviceUUID) == uuid:
-                chosen = device
-        if chosen is None:
-            self.close()
-            raise SharingUnavailable(f"no Vulkan device has the OpenCL device's UUID {uuid.hex()}")
-        priority = ctypes.c_float(1.0)
-        queue = _DeviceQueueCreateInfo(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO, None, 0, 0, 1,
-                                       ctypes.pointer(priority))
-        names = (ctypes.c_char_p * 1)(b"VK_KHR_external_semaphore_fd")
-        device_info = _DeviceCreateInfo(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, None, 0, 1,
-                                        ctypes.cast(ctypes.pointer(queue), _ptr), 0, None, 1,
-                                        ctypes.cast(names, _ptr), None)
-        self.device = _ptr()
-        self._check("vkCreateDevice", vk.vkCreateDevice(chosen, ctypes.byref(device_info), None,
-                                                        ctypes.byref(self.device)))
-        vk.vkGetDeviceProcAddr.restype, vk.vkGetDeviceProcAddr.argtypes = _ptr, [_ptr, ctypes.c_char_p]
-        self._get_fd = ctypes.CFUNCTYPE(ctypes.c_int, _ptr, _ptr, ctypes.POINTER(ctypes.c_int))(
-            vk.vkGetDeviceProcAddr(self.device, b"vkGetSemaphoreFdKHR"))
 
-    def _instance_function(self, name: str, restype, *argtypes):
-        return ctypes.CFUNCTYPE(restype, *argtypes)(self.vk.vkGetInstanceProcAddr(self.instance, name.encode()))
+class OpenCLSemaphores:
+    """cl_khr_external_semaphore on the session's device: binary semaphores made by the process's
+    Vulkan device on that GPU (``vulkan``) and imported into the session's context, to wait on and
+    signal (share="gl" and share="vulkan": ``api``).  An output set borrows its pair (``lend``)
+    and gives it back when it closes, unsignalled, for the next set of that context: they are
+    imported once per context and kept for the process.  NVIDIA's OpenCL (driver 580) keeps a
+    ``/dev/nvidiactl`` descriptor open for every semaphore imported and released in a context that
+    also holds imported memory: one more per closed session before this (bench/RESULTS.md,
+    "Session 18, lead", fd_parts5.txt)."""
 
-    @staticmethod
-    def _check(name: str, result: int) -> None:
-        if result:
-            raise RuntimeError(f"Vulkan {name} failed: {result}")
+    _spare: dict = {}  # the context's int_ptr -> (the context, its free (Vulkan, OpenCL) semaphore pairs)
 
-    def semaphore(self) -> int:
-        """A binary semaphore whose payload can be exported as an opaque fd."""
-        export = _ExportSemaphoreCreateInfo(VK_STRUCTURE_TYPE_EXPORT_SEMAPHORE_CREATE_INFO, None,
-                                            VK_EXTERNAL_SEMAPHORE_HANDLE_TYPE_OPAQUE_FD_BIT)
-        create = _SemaphoreCreateInfo(VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO,
-                                      ctypes.cast(ctypes.pointer(export), _ptr), 0)
-        semaphore = _u64()
-        self._check("vkCreateSemaphore", self.vk.vkCreateSemaphore(self.device, ctypes.byref(create), None,
-                                                                   ctypes.byref(semaphore)))
-        return semaphore.value
-
-    def destroy(self, semaphore: int) -> None:
-        self.vk.vkDestroySemaphore(self.device, _u64(semaphore), None)
-
-    def fd(self, semaphore: int) -> int:
-        """A new opaque fd of ``semaphore`` (each importer takes one over)."""
-        info = _SemaphoreGetFdInfo(VK_STRUCTURE_TYPE_SEMAPHORE_GET_FD_INFO_KHR, None, semaphore,
-                                   VK_EXTERNAL_SEMAPHORE_HANDLE_TYPE_OPAQUE_FD_BIT)
-        fd = ctypes.c_int(-1)
-        self._check("vkGetSemaphoreFdKHR", self._get_fd(self.device, ctypes.byref(info), ctypes.byref(fd)))
-        return fd.value
-
-    def close(self) -> None:  # (only when making it failed half-way)
-        if self.instance:
-            self.vk.vkDestroyInstance(self.instance, None)
-            self.instance = None
-
-
-class _OpenCLSemaphores:
-    """cl_khr_external_semaphore on the session's device: an imported fd, wait and signal."""
-
-    def __init__(self, opencl, device: cl.Device):
+    def __init__(self, opencl, device: cl.Device, api: str):
         missing = [name for name in NEEDED_CL_EXTENSIONS if name not in device.extensions.split()]
         if missing:
-            raise SharingUnavailable(f"{device.name.strip()}: share=\"gl\" needs the OpenCL extensions "
+            raise SharingUnavailable(f"{device.name.strip()}: share=\"{api}\" needs the OpenCL extensions "
                                      f"{', '.join(missing)}, which this device does not offer")
         function = opencl.extension_function
         self.context, self.device = opencl.context, device
@@ -291,7 +158,20 @@ class _OpenCLSemaphores:
         enqueue = (ctypes.c_int, _ptr, _u32, ctypes.POINTER(_ptr), _ptr, _u32, _ptr, _ptr)
         self._wait = function("clEnqueueWaitSemaphoresKHR", *enqueue)
         self._signal = function("clEnqueueSignalSemaphoresKHR", *enqueue)
-        self._release = function("clReleaseSemaphoreKHR", ctypes.c_int, _ptr)
+        self.vulkan = _VulkanSemaphores.for_uuid(opencl.uuid, api)
+
+    def lend(self) -> tuple[int, int]:
+        """An unsignalled (Vulkan semaphore, OpenCL semaphore) pair on one payload, for one output
+        set until it gives it back; ``vulkan.fd`` of the first hands it to another API."""
+        _, spare = self._spare.setdefault(self.context.int_ptr, (self.context, []))
+        if spare:
+            return spare.pop()
+        semaphore = self.vulkan.make()
+        return semaphore, self.import_fd(self.vulkan.fd(semaphore))
+
+    def give_back(self, pair: tuple[int, int]) -> None:
+        """A lent pair back, unsignalled and with nothing pending on it."""
+        self._spare[self.context.int_ptr][1].append(pair)
 
     def import_fd(self, fd: int) -> int:
         """An OpenCL binary semaphore on the payload behind ``fd`` (which OpenCL takes over).
@@ -311,9 +191,6 @@ class _OpenCLSemaphores:
         result = function(queue.int_ptr, 1, semaphores, None, 0, None, None)
         if result:
             raise RuntimeError(f"clEnqueue{command.title()}SemaphoresKHR failed: {result}")
-
-    def release(self, semaphore: int) -> None:
-        self._release(semaphore)
 
 
 class GlBuffer:
@@ -346,19 +223,17 @@ class GlOutputBuffers(CudaOutputBuffers):
     def __init__(self, tessellator, pinned: bool = False):
         self.gl = _CurrentGL()  # first: without a current GL context nothing else is made
         super().__init__(tessellator, pinned)
-        self.cl_semaphores = _OpenCLSemaphores(self.opencl, tessellator.device)
-        self.vulkan = _VulkanSemaphores.for_uuid(self.opencl.uuid)
+        self.cl_semaphores = OpenCLSemaphores(self.opencl, tessellator.device, "gl")
         self._gl_objects: dict = {}  # name -> (GL memory object, GL buffer)
         self._with_gl = False  # whether GL has the buffers (frame.gl() since OpenCL last took them)
-        self._cl_semaphore, self._gl_semaphore = {}, {}  # "ready" / "done" -> imported handle
-        self._vk_semaphores = []
+        self._lent, self._cl_semaphore, self._gl_semaphore = {}, {}, {}  # "ready" / "done" -> pair, handles
         for role in ("ready", "done"):
-            semaphore = self.vulkan.semaphore()
-            self._vk_semaphores.append(semaphore)
-            self._cl_semaphore[role] = self.cl_semaphores.import_fd(self.vulkan.fd(semaphore))
+            self._lent[role] = self.cl_semaphores.lend()
+            self._cl_semaphore[role] = self._lent[role][1]
             made = _u32()
             self.gl.glGenSemaphoresEXT(1, ctypes.byref(made))
-            self.gl.glImportSemaphoreFdEXT(made, GL_HANDLE_TYPE_OPAQUE_FD_EXT, self.vulkan.fd(semaphore))
+            self.gl.glImportSemaphoreFdEXT(made, GL_HANDLE_TYPE_OPAQUE_FD_EXT,
+                                           self.cl_semaphores.vulkan.fd(self._lent[role][0]))
             self._gl_semaphore[role] = made.value
         self.gl.raise_error("importing the semaphores")
 
@@ -411,15 +286,11 @@ class GlOutputBuffers(CudaOutputBuffers):
             self.gl.glWaitSemaphoreEXT(self._gl_semaphore["ready"], len(buffers), buffers, 0, None, None)
             self.gl.raise_error("waiting for the frame in OpenGL")
             self._with_gl = True
-        arrays = GlBuffers()
-        for name, dtype, shape in self._layout():
-            rows = num_triangles if name == "triangles" else num_vertices
-            arrays[name] = GlBuffer(self._gl_objects[name][1], rows, shape, dtype)
-        return arrays
+        return self._shared_fields(GlBuffers(), num_vertices, num_triangles,
+                                   lambda name, *layout: GlBuffer(self._gl_objects[name][1], *layout))
 
     def take(self, num_vertices: int, num_triangles: int):
-        if not self._gl_semaphore:
-            raise RuntimeError("this share=\"gl\" Session was closed: make a new one")
+        self._check_open(self._gl_semaphore)
         return super().take(num_vertices, num_triangles)
 
     def close(self) -> None:
@@ -433,11 +304,9 @@ class GlOutputBuffers(CudaOutputBuffers):
         for name in list(self._gl_objects):
             self._delete_gl(name)
         self.gl.glDeleteSemaphoresEXT(2, (_u32 * 2)(*self._gl_semaphore.values()))
-        for semaphore in self._cl_semaphore.values():
-            self.cl_semaphores.release(semaphore)
-        for semaphore in self._vk_semaphores:
-            self.vulkan.destroy(semaphore)
-        self._cl_semaphore, self._gl_semaphore, self._vk_semaphores = {}, {}, []
+        for pair in self._lent.values():  # (unsignalled: OpenCL waited for done, which GL signalled after ready)
+            self.cl_semaphores.give_back(pair)
+        self._lent, self._cl_semaphore, self._gl_semaphore = {}, {}, {}
         super().close()
 
 

@@ -1,0 +1,7 @@
+# Session 18, H200, call 11: the semaphores' release order, and kept semaphores: which keeps a /dev/nvidiactl (fd_parts5.py).
+# From /work/main, carry [".whl", ".gl", "probe/gl"].
+for f in .gl/*.deb; do dpkg -x $f /; done; ldconfig
+export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
+. bench/gpu_setup.sh >/dev/null
+timeout 200 python3 -X faulthandler probe/gl/fd_parts5.py 2>&1 | grep -v "Warn\|prg.build\|_create_built" > $OUT/fd_parts5.txt
+cat $OUT/fd_parts5.txt
