@@ -52,8 +52,8 @@ from .vulkan import (NEEDED_VK_EXTENSIONS, VK_ACCESS_MEMORY_READ_BIT, VK_ACCESS_
                      VK_STRUCTURE_TYPE_IMPORT_MEMORY_FD_INFO_KHR, VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, VK_WHOLE_SIZE,
                      BufferCreateInfo, BufferMemoryBarrier, CommandBufferAllocateInfo, CommandBufferBeginInfo,
                      CommandPoolCreateInfo, ExternalMemoryBufferCreateInfo, ImportMemoryFdInfo,
-                     MemoryAllocateInfo, MemoryRequirements, PhysicalDeviceMemoryProperties, check, device_uuid,
-                     imported_semaphore, loader, pointer_to, submit)
+                     MemoryAllocateInfo, MemoryRequirements, PhysicalDeviceMemoryProperties, check, check_extensions,
+                     device_uuid, imported_semaphore, loader, pointer_to, submit)
 
 _u32, _u64, _ptr = ctypes.c_uint32, ctypes.c_uint64, ctypes.c_void_p
 
@@ -123,6 +123,7 @@ class VulkanOutputBuffers(CudaOutputBuffers):
         if device_uuid(vk, physical) != self.opencl.uuid:
             raise SharingUnavailable(f"the Vulkan device is not on the session's GPU (UUID "
                                      f"{self.opencl.uuid.hex()})")
+        check_extensions(vk, self.device)
         self.memory_types = PhysicalDeviceMemoryProperties()
         vk.vkGetPhysicalDeviceMemoryProperties(physical, ctypes.byref(self.memory_types))
         pool = CommandPoolCreateInfo(VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO, None, 0, self.family)

@@ -51,8 +51,11 @@ VK_QUEUE_FAMILY_EXTERNAL = 0xFFFFFFFE  # (~1U)
 VK_WHOLE_SIZE = 0xFFFFFFFFFFFFFFFF
 VK_QUEUE_GRAPHICS_BIT, VK_QUEUE_COMPUTE_BIT, VK_QUEUE_TRANSFER_BIT = 0x1, 0x2, 0x4
 
-#: The device extensions share="vulkan" needs in the caller's device (and share="gl" in its own).
+#: The device extensions share="vulkan" needs in the caller's device (and share="gl" in its own),
+#: each with a function of its own, found only where it was enabled (``check_extensions``).
 NEEDED_VK_EXTENSIONS = ("VK_KHR_external_memory_fd", "VK_KHR_external_semaphore_fd")
+EXTENSION_FUNCTIONS = {"VK_KHR_external_memory_fd": "vkGetMemoryFdKHR",
+                       "VK_KHR_external_semaphore_fd": "vkImportSemaphoreFdKHR"}
 
 
 class ApplicationInfo(ctypes.Structure):
@@ -250,6 +253,14 @@ def device_uuid(vk: ctypes.CDLL, physical_device) -> bytes:
     wanted = PhysicalDeviceProperties2(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, pointer_to(ids))
     vk.vkGetPhysicalDeviceProperties2(physical_device, ctypes.byref(wanted))
     return bytes(ids.deviceUUID)
+
+
+def check_extensions(vk: ctypes.CDLL, device, extensions=NEEDED_VK_EXTENSIONS) -> None:
+    """SharingUnavailable naming the extensions that ``device`` was made without (a device-level
+    function of an extension not enabled has no address)."""
+    missing = [name for name in extensions if not vk.vkGetDeviceProcAddr(device, EXTENSION_FUNCTIONS[name].encode())]
+    if missing:
+        raise SharingUnavailable(f"the Vulkan device was made without {', '.join(missing)}, which sharing needs")
 
 
 def device_function(vk: ctypes.CDLL, device, name: str, restype, *argtypes):
