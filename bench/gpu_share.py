@@ -1,10 +1,12 @@
-"""Issue 15: a Session's output handed to CUDA without a copy (``Session(share="cuda")``,
-``frame.cuda()``: cltess/backends/opencl/share_cuda.py), against the same frames kept on the
-OpenCL device and read back to host arrays, side by side in one run on one tessellator.
+"""Issue 15: a Session's output handed without a copy to CUDA, OpenGL and Vulkan
+(``Session(share="cuda" | "gl" | "vulkan")``: cltess/backends/opencl/share_cuda.py, share_gl.py,
+share_vulkan.py), against the same frames kept on the OpenCL device and read back to host
+arrays, side by side in one run on one tessellator.
 
     python bench/gpu_share.py --device nvidia [--frames 10] [--scenes tea_table killeroo ...] [--copies 1000]
+                              [--no-gl] [--no-vulkan]
 
-Per scene, for each camera of an orbit (frame_loop.orbit), three frames in turn:
+Per scene, for each camera of an orbit (frame_loop.orbit), these frames in turn:
 
 * **resident**: a plain Session frame, waited for (``tessellate`` then ``finish``): the output
   on the OpenCL device;
