@@ -42,6 +42,7 @@ frame's ``fetch()``).  Twice the output memory; each set grows when its own turn
 from __future__ import annotations
 
 import dataclasses
+import importlib
 import time
 from dataclasses import dataclass, field
 
@@ -54,23 +55,10 @@ from .scene import Camera, Scene
 from .tessellation import Tessellation
 
 
-def _cuda_outputs():
-    from .backends.opencl.share_cuda import CudaOutputBuffers
-    return CudaOutputBuffers
-
-
-def _gl_outputs():
-    from .backends.opencl.share_gl import GlOutputBuffers
-    return GlOutputBuffers
-
-
-def _vulkan_outputs():
-    from .backends.opencl.share_vulkan import VulkanOutputBuffers
-    return VulkanOutputBuffers
-
-
-#: Session(share=...): the output buffers' class, by the API the output is handed to.
-SHARED_OUTPUTS = {None: lambda: OutputBuffers, "cuda": _cuda_outputs, "gl": _gl_outputs, "vulkan": _vulkan_outputs}
+#: Session(share=...): the output buffers' class, by the API the output is handed to, as
+#: (module of backends/opencl, class), imported when a Session asks for it.
+SHARED_OUTPUTS = {None: ("output", "OutputBuffers"), "cuda": ("share_cuda", "CudaOutputBuffers"),
+                  "gl": ("share_gl", "GlOutputBuffers"), "vulkan": ("share_vulkan", "VulkanOutputBuffers")}
 
 
 @dataclass
@@ -114,7 +102,8 @@ class Session:
         self.scene = scene
         self.request = request if request is not None else Request.of(**options)
         self.request.check(scene)
-        outputs = SHARED_OUTPUTS[share]()
+        module, name = SHARED_OUTPUTS[share]
+        outputs = getattr(importlib.import_module(f".backends.opencl.{module}", __package__), name)
         where = {"vulkan": vulkan} if share == "vulkan" else {}
         self._sets = [FrameBuffers(outputs(self.tessellator, pinned=True, **where)) for _ in range(buffers)]
         self._current = self._sets[0]  # the set of the latest frame (the next frame's before the first)

@@ -127,7 +127,7 @@ def test_shared_memory_and_its_descriptors_go_with_the_session(sharing, tea_tabl
 def test_the_apis_a_device_can_share_with_follow_its_extensions(cuda_part, gl_part):
     from types import SimpleNamespace
 
-    from cltess.backends.opencl.share_gl import NEEDED_CL_EXTENSIONS
+    from cltess.backends.opencl.handover import NEEDED_CL_EXTENSIONS
 
     extensions = ["cl_khr_fp64", *NEEDED_EXTENSIONS[:cuda_part], *NEEDED_CL_EXTENSIONS[:gl_part]]
     cuda = cuda_part == len(NEEDED_EXTENSIONS)

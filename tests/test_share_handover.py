@@ -143,7 +143,7 @@ def test_closing_a_session_frees_its_objects_and_descriptors(tessellator, receiv
     receiver.settle()  # (the API's deletions done)
     after = open_descriptors()
     # Every exported fd is closed, and nothing of the driver's stays: the semaphores are lent from
-    # the context's pool (share_gl.OpenCLSemaphores), which the first session filled.  (Importing
+    # the context's pool (handover.OpenCLSemaphores), which the first session filled.  (Importing
     # and releasing them per session left one /dev/nvidiactl each: bench/RESULTS.md, "Session 18,
     # lead".)
     kept = sorted(set(after.items()) - set(before.items()))

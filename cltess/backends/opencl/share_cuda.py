@@ -56,9 +56,9 @@ NEEDED_EXTENSIONS = ("cl_khr_external_memory", "cl_khr_external_memory_opaque_fd
 def sharing_apis(device) -> list[str]:
     """The APIs that ``Session(share=...)`` can hand this OpenCL device's output to, by its
     extensions alone ("cuda": NEEDED_EXTENSIONS; "gl" and "vulkan": those and
-    share_gl.NEEDED_CL_EXTENSIONS, the semaphores).  The rest (libcuda, the Vulkan loader, a
+    handover.NEEDED_CL_EXTENSIONS, the semaphores).  The rest (libcuda, the Vulkan loader, a
     current GL context, the caller's Vulkan device) is checked when the Session is made."""
-    from .share_gl import NEEDED_CL_EXTENSIONS
+    from .handover import NEEDED_CL_EXTENSIONS
 
     extensions = set(device.extensions.split())
     if not extensions.issuperset(NEEDED_EXTENSIONS):
@@ -401,11 +401,6 @@ class CudaOutputBuffers(OutputBuffers):
         for name, dtype, shape in self._layout():
             fields[name] = make(name, num_triangles if name == "triangles" else num_vertices, shape, dtype)
         return fields
-
-    def _check_open(self, still_open) -> None:
-        """Refuse a frame after close() (``still_open``: what close() empties)."""
-        if not still_open:
-            raise RuntimeError(f"this share=\"{self.shares}\" Session was closed: make a new one")
 
 
 __all__ = ["CudaArray", "CudaArrays", "CudaOutputBuffers", "SharedFields", "SharingUnavailable", "sharing_apis"]

@@ -5,10 +5,10 @@ from.
 
 The memory is share_cuda.py's (CUDA allocates and exports it, OpenCL imports it), imported once
 more by the caller's device (``VK_KHR_external_memory_fd``: a ``VkDeviceMemory`` per field and a
-``VkBuffer`` bound to all of it).  Two binary semaphores, lent by share_gl.OpenCLSemaphores
-(made by the process's own Vulkan device, imported into OpenCL, kept for the context), are
-imported by the caller's device too (``VK_KHR_external_semaphore_fd``), as share_gl.py does with
-GL:
+``VkBuffer`` bound to all of it).  The hand-over is handover.py's: its two binary semaphores
+(made by the process's own Vulkan device, imported into OpenCL, kept for the context) are
+imported by the caller's device too (``VK_KHR_external_semaphore_fd``), and the caller's queue
+does the other API's side:
 
 * ``ready``: ``frame.vulkan()`` enqueues OpenCL's release of the buffers and a signal of
   ``ready``, then submits to the caller's queue a batch that waits for ``ready`` and acquires the
@@ -37,8 +37,8 @@ from dataclasses import dataclass
 import numpy as np
 import pyopencl as cl
 
-from .share_cuda import CudaOutputBuffers, SharedFields, SharingUnavailable
-from .share_gl import OpenCLSemaphores
+from .handover import HandedOverBuffers
+from .share_cuda import SharedFields, SharingUnavailable
 from .vulkan import (NEEDED_VK_EXTENSIONS, VK_ACCESS_MEMORY_READ_BIT, VK_ACCESS_MEMORY_WRITE_BIT,
                      VK_BUFFER_USAGE_INDEX_BUFFER_BIT, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                      VK_BUFFER_USAGE_TRANSFER_DST_BIT, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
@@ -105,9 +105,10 @@ class VulkanBuffers(SharedFields):
     """A frame's output as ``VulkanBuffer``s."""
 
 
-class VulkanOutputBuffers(CudaOutputBuffers):
+class VulkanOutputBuffers(HandedOverBuffers):
     """CudaOutputBuffers that the caller's Vulkan device imports too, handed over by semaphores
-    and queue family ownership transfers on the caller's queue (the module's notes)."""
+    (handover.py) and queue family ownership transfers on the caller's queue (the module's
+    notes)."""
 
     shares = "vulkan"
 
@@ -116,7 +117,6 @@ class VulkanOutputBuffers(CudaOutputBuffers):
             raise ValueError("share=\"vulkan\" needs vulkan=VulkanQueue(device, physical_device, queue, family): "
                              f"got {vulkan!r}")
         super().__init__(tessellator, pinned)
-        self.cl_semaphores = OpenCLSemaphores(self.opencl, tessellator.device, "vulkan")
         vk = self.vk = loader("vulkan")
         self.device, physical = _ptr(_handle(vulkan.device)), _ptr(_handle(vulkan.physical_device))
         self.vk_queue, self.family = _ptr(_handle(vulkan.queue)), int(vulkan.family)
@@ -126,24 +126,16 @@ class VulkanOutputBuffers(CudaOutputBuffers):
         check_extensions(vk, self.device)
         self.memory_types = PhysicalDeviceMemoryProperties()
         vk.vkGetPhysicalDeviceMemoryProperties(physical, ctypes.byref(self.memory_types))
-        pool = CommandPoolCreateInfo(VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO, None, 0, self.family)
-        self._pool = _u64()
-        check("vkCreateCommandPool", vk.vkCreateCommandPool(self.device, ctypes.byref(pool), None,
-                                                            ctypes.byref(self._pool)))
-        self._lent, self._vk_semaphore, self._cl_semaphore = {}, {}, {}  # "ready" / "done" -> pair, handles
-        try:
-            for role in ("ready", "done"):
-                self._lent[role] = self.cl_semaphores.lend()
-                self._cl_semaphore[role] = self._lent[role][1]
-                self._vk_semaphore[role] = imported_semaphore(vk, self.device,
-                                                              self.cl_semaphores.vulkan.fd(self._lent[role][0]))
-        except Exception:  # (nothing signalled yet: what was lent goes back, what was made goes)
-            self._forget_semaphores()
-            vk.vkDestroyCommandPool(self.device, self._pool, None)
-            raise
+        self._vk_semaphore = {}  # "ready" / "done" -> the caller's device's semaphore
         self._vk_objects: dict = {}  # name -> (VkBuffer, VkDeviceMemory)
+        self._pool = None  # the command pool of the transfers (made with them)
         self._transfers = None  # (acquire, release) command buffers for the current buffers
-        self._with_vulkan = False  # whether the caller's queue has the buffers (since frame.vulkan())
+        self._borrow_semaphores()
+
+    def _import_semaphores(self) -> None:
+        for role, (vulkan_semaphore, _) in self._lent.items():
+            self._vk_semaphore[role] = imported_semaphore(self.vk, self.device,
+                                                          self.cl_semaphores.vulkan.fd(vulkan_semaphore))
 
     def _memory_type(self, allowed: int) -> int:
         """A memory type among the ``allowed`` bits, device-local if one is."""
@@ -200,6 +192,11 @@ class VulkanOutputBuffers(CudaOutputBuffers):
         """Two command buffers for the current buffers: acquire from ``VK_QUEUE_FAMILY_EXTERNAL``
         into the caller's family, and release back (each a buffer barrier per field)."""
         vk, commands = self.vk, (_ptr * 2)()
+        if self._pool is None:
+            pool, made = CommandPoolCreateInfo(VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO, None, 0, self.family), _u64()
+            check("vkCreateCommandPool", vk.vkCreateCommandPool(self.device, ctypes.byref(pool), None,
+                                                                ctypes.byref(made)))
+            self._pool = made
         allocate = CommandBufferAllocateInfo(VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO, None, self._pool, 0, 2)
         check("vkAllocateCommandBuffers", vk.vkAllocateCommandBuffers(self.device, ctypes.byref(allocate), commands))
         access = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT
@@ -219,50 +216,32 @@ class VulkanOutputBuffers(CudaOutputBuffers):
         self._transfers = commands
         return commands
 
-    def _reclaim(self) -> None:
-        if self._with_vulkan and self._buffers:  # released by the caller's queue after its commands: done
-            submit(self.vk, self.vk_queue, command_buffer=self._transfers[1], signal=self._vk_semaphore["done"])
-            self.cl_semaphores.enqueue("wait", self.queue, self._cl_semaphore["done"])
-            self._with_vulkan = False
+    def _signal_done(self) -> None:  # (released by the caller's queue after its commands)
+        submit(self.vk, self.vk_queue, command_buffer=self._transfers[1], signal=self._vk_semaphore["done"])
+
+    def _wait_ready(self) -> None:
+        transfers = self._transfers if self._transfers is not None else self._record_transfers()
+        submit(self.vk, self.vk_queue, wait=self._vk_semaphore["ready"], command_buffer=transfers[0])
 
     def share(self, num_vertices: int, num_triangles: int) -> VulkanBuffers:
-        """The current output handed to the caller's queue: released by OpenCL, ``ready``
-        signalled behind it, waited for and the buffers acquired on that queue (no host wait)."""
-        if self._held:
-            self._let_go()
-            self.cl_semaphores.enqueue("signal", self.queue, self._cl_semaphore["ready"])
-            self.queue.flush()
-            transfers = self._transfers if self._transfers is not None else self._record_transfers()
-            submit(self.vk, self.vk_queue, wait=self._vk_semaphore["ready"], command_buffer=transfers[0])
-            self._with_vulkan = True
+        """The current output handed to the caller's queue (HandedOverBuffers._hand_over: no
+        host wait), the buffers acquired there."""
+        self._hand_over()
         return self._shared_fields(VulkanBuffers(), num_vertices, num_triangles,
                                    lambda name, *layout: VulkanBuffer(*self._vk_objects[name], *layout))
 
-    def take(self, num_vertices: int, num_triangles: int):
-        self._check_open(self._vk_semaphore)
-        return super().take(num_vertices, num_triangles)
-
-    def close(self) -> None:
-        """Destroy what was made in the caller's device, after its queue gave the buffers back
-        and OpenCL finished.  No frame can be made after it."""
-        if not self._vk_semaphore:  # (closed already)
-            return
-        self._reclaim()
-        self.queue.finish()  # (waited for done: the caller's queue is past every batch made here)
+    def _close_api(self) -> None:
+        """What was made in the caller's device goes (its queue is past every batch made here:
+        OpenCL waited for done, or none was submitted)."""
         self._free_transfers()
         for name in list(self._vk_objects):
             self._delete_vulkan(name)
-        self.vk.vkDestroyCommandPool(self.device, self._pool, None)
-        self._forget_semaphores()  # (unsignalled: OpenCL waited for done, signalled after ready's wait)
-        super().close()
-
-    def _forget_semaphores(self) -> None:
-        """Destroy the caller's device's semaphores and give the lent pairs back."""
+        if self._pool is not None:
+            self.vk.vkDestroyCommandPool(self.device, self._pool, None)
+            self._pool = None
         for semaphore in self._vk_semaphore.values():
             self.vk.vkDestroySemaphore(self.device, _u64(semaphore), None)
-        for pair in self._lent.values():
-            self.cl_semaphores.give_back(pair)
-        self._lent, self._vk_semaphore, self._cl_semaphore = {}, {}, {}
+        self._vk_semaphore = {}
 
 
 __all__ = ["NEEDED_VK_EXTENSIONS", "VulkanBuffer", "VulkanBuffers", "VulkanOutputBuffers", "VulkanQueue"]

@@ -340,9 +340,6 @@ class ExportableSemaphores:
                                                              ctypes.byref(semaphore)))
         return semaphore.value
 
-    def destroy(self, semaphore: int) -> None:
-        self.vk.vkDestroySemaphore(self.device, _u64(semaphore), None)
-
     def fd(self, semaphore: int) -> int:
         """A new opaque fd of ``semaphore`` (each importer takes one over)."""
         info = SemaphoreGetFdInfo(VK_STRUCTURE_TYPE_SEMAPHORE_GET_FD_INFO_KHR, None, semaphore,
