@@ -20,7 +20,9 @@
  * are made once per patch (pattern_triangles_of), the row by a float reciprocal, and a group's
  * triangles are numbered in 32 bits: 133 instructions per 32 triangles, 0.133 -> 0.115 ms on the
  * H200 at uniform level 16 (bench/RESULTS.md, "Issue 15: stage 4's write-out and stage 5's
- * instructions (session 10, branch gpu15i)").
+ * instructions (session 10, branch gpu15i)").  A cell's pair goes as three 8-byte stores where
+ * the launch's output is 8-byte aligned (half the store instructions, each of a warp's over the
+ * same 24 sectors): 0.115 -> 0.105 ms there (bench/RESULTS.md, "Session 19, lead").
  * The batch is patches first_patch .. first_patch + num_patches - 1; work-items past its last
  * triangle stop. */
 __kernel void triangles(__global const int4 *factors, __global const ulong *vertex_offsets,
@@ -40,6 +42,9 @@ __kernel void triangles(__global const int4 *factors, __global const ulong *vert
         return;
     uint stop = (uint)min(end - start, (ulong)group * per_item);
     __global uint *out = indices + 3 * (start - index_base / 3);
+    /* Where out is 8-byte aligned, so is an even r's triangle (12 r bytes on): a cell's two
+     * triangles, 24 bytes, then go as three 8-byte stores instead of six 4-byte ones. */
+    int words = ((ulong)out & 7) == 0;
     uint p = first_patch, base = 0, patch_start = 0, patch_end = 0;  /* the patch's triangles; none found yet */
     int4 f = (int4)(0);
     int collapsed = 0, direct = 0;
@@ -65,6 +70,14 @@ __kernel void triangles(__global const int4 *factors, __global const ulong *vert
                 int pairs;
                 uint d;
                 uint3 triangle = pattern_triangle_pair(&grid, t, &pairs, &d);
+                if (words && r == r0 && pairs && r + 1 < stop) {  /* (a, b, c) and (a, c, d), word pairs */
+                    __global uint2 *to = (__global uint2 *)(out + 3 * r);
+                    triangle += base;
+                    to[0] = (uint2)(triangle.x, triangle.y);
+                    to[1] = (uint2)(triangle.z, triangle.x);
+                    to[2] = (uint2)(triangle.z, d + base);
+                    break;
+                }
                 vstore3(triangle + base, r, out);
                 if (r == r0 && pairs && r + 1 < stop) {  /* t + 1: (a, c, d) of the same cell */
                     vstore3((uint3)(triangle.x, triangle.z, d) + base, r + 1, out);
