@@ -1,7 +1,8 @@
 """Stage 5 a work-item per triangle (stages/triangles.cl, issue 15) against the NumPy mirror: on
 random quad factors (uniform grids, transitions, collapsed edges, culled patches) the kernel's
 indices are cltess.patterns.quad_transition.quad_pattern's, each patch's triangles offset by its
-first vertex; for the whole scene and a batch inside it (first_patch > 0), at 1, 3, 16 and 40
+first vertex; for the whole scene and a batch inside it (first_patch > 0; also at an output
+offset of one triangle, so not 8-byte aligned: a cell's pair by vstore3), at 1, 3, 16 and 40
 triangles per work-item (a work-item's triangles cross patches, and the batch's end falls inside
 a work-group).  Random access (pattern_triangle_at) makes the uniform grids' triangles,
 pattern_primitives the others'."""
@@ -46,9 +47,14 @@ def test_triangles_are_the_mirrors(tessellator, rng, per_item):
     device = {name: cl_array.to_device(queue, a) for name, a in
               (("factors", factors.view(cltypes.int4).reshape(-1)), ("vertices", vertex_offsets),
                ("indices", index_offsets))}
-    for first, last in ((0, len(factors)), (37, 451)):  # the whole scene; a batch inside it
+    # the whole scene; a batch inside it; the same batch in a range one triangle longer at its
+    # start, so that the batch's output is not 8-byte aligned (a cell's pair then by vstore3, not
+    # as three 8-byte words)
+    for first, last, before in ((0, len(factors), 0), (37, 451, 0), (37, 451, 1)):
         start, stop = int(index_offsets[first]), int(index_offsets[last])
+        assert start >= 3 * before
         got, events = by_points.stage_indices(device["factors"], device["vertices"], device["indices"],
-                                              (start, stop), (first, last), kind=BEZIER, work="point")
+                                              (start - 3 * before, stop), (first, last), kind=BEZIER, work="point")
         cl.wait_for_events(events)
-        assert np.array_equal(got.get().reshape(-1), expected.reshape(-1)[start:stop]), (first, last)
+        got = got.get().reshape(-1)[3 * before:]
+        assert np.array_equal(got, expected.reshape(-1)[start:stop]), (first, last, before)

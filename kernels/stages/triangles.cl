@@ -22,7 +22,7 @@
  * H200 at uniform level 16 (bench/RESULTS.md, "Issue 15: stage 4's write-out and stage 5's
  * instructions (session 10, branch gpu15i)").  A cell's pair goes as three 8-byte stores where
  * the launch's output is 8-byte aligned (half the store instructions, each of a warp's over the
- * same 24 sectors): 0.115 -> 0.105 ms there (bench/RESULTS.md, "Session 19, lead").
+ * same 24 sectors): 0.115-0.116 -> 0.105-0.106 ms there (bench/RESULTS.md, "Session 19, lead").
  * The batch is patches first_patch .. first_patch + num_patches - 1; work-items past its last
  * triangle stop. */
 __kernel void triangles(__global const int4 *factors, __global const ulong *vertex_offsets,
