@@ -69,20 +69,21 @@ __kernel void triangles(__global const int4 *factors, __global const ulong *vert
             if (direct) {
                 int pairs;
                 uint d;
-                uint3 triangle = pattern_triangle_pair(&grid, t, &pairs, &d);
-                if (words && r == r0 && pairs && r + 1 < stop) {  /* (a, b, c) and (a, c, d), word pairs */
-                    __global uint2 *to = (__global uint2 *)(out + 3 * r);
-                    triangle += base;
-                    to[0] = (uint2)(triangle.x, triangle.y);
-                    to[1] = (uint2)(triangle.z, triangle.x);
-                    to[2] = (uint2)(triangle.z, d + base);
+                uint3 triangle = pattern_triangle_pair(&grid, t, &pairs, &d) + base;
+                d += base;
+                if (r == r0 && pairs && r + 1 < stop) {  /* and t + 1: (a, c, d) of the same cell */
+                    if (words) {
+                        __global uint2 *to = (__global uint2 *)(out + 3 * r);
+                        to[0] = (uint2)(triangle.x, triangle.y);
+                        to[1] = (uint2)(triangle.z, triangle.x);
+                        to[2] = (uint2)(triangle.z, d);
+                    } else {
+                        vstore3(triangle, r, out);
+                        vstore3((uint3)(triangle.x, triangle.z, d), r + 1, out);
+                    }
                     break;
                 }
-                vstore3(triangle + base, r, out);
-                if (r == r0 && pairs && r + 1 < stop) {  /* t + 1: (a, c, d) of the same cell */
-                    vstore3((uint3)(triangle.x, triangle.z, d) + base, r + 1, out);
-                    break;
-                }
+                vstore3(triangle, r, out);
                 continue;
             }
 #endif

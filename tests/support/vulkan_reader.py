@@ -20,8 +20,8 @@ from cltess.backends.opencl.vulkan import (VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                            VK_STRUCTURE_TYPE_FENCE_CREATE_INFO, VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO,
                                            BufferCopy, BufferCreateInfo, CommandBufferAllocateInfo,
                                            CommandBufferBeginInfo, CommandPoolCreateInfo, FenceCreateInfo,
-                                           MemoryAllocateInfo, MemoryRequirements, PhysicalDeviceMemoryProperties,
-                                           VulkanDevice, check, submit)
+                                           MemoryAllocateInfo, MemoryRequirements, VulkanDevice, check,
+                                           memory_type, submit)
 
 _u64, _ptr = ctypes.c_uint64, ctypes.c_void_p
 
@@ -40,8 +40,6 @@ class VulkanReader(VulkanDevice):
         fence = FenceCreateInfo(VK_STRUCTURE_TYPE_FENCE_CREATE_INFO, None, 0)
         self.fence = _u64()
         check("vkCreateFence", vk.vkCreateFence(self.device, ctypes.byref(fence), None, ctypes.byref(self.fence)))
-        self.memory_types = PhysicalDeviceMemoryProperties()
-        vk.vkGetPhysicalDeviceMemoryProperties(self.physical_device, ctypes.byref(self.memory_types))
 
     def queue_for_session(self) -> VulkanQueue:
         return VulkanQueue(self.device.value, self.physical_device.value, self.queue.value, self.family)
@@ -54,10 +52,8 @@ class VulkanReader(VulkanDevice):
         check("vkCreateBuffer", vk.vkCreateBuffer(self.device, ctypes.byref(create), None, ctypes.byref(buffer)))
         needs = MemoryRequirements()
         vk.vkGetBufferMemoryRequirements(self.device, buffer, ctypes.byref(needs))
-        wanted = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
-        types = self.memory_types.memoryTypes
-        kind = next(k for k in range(self.memory_types.memoryTypeCount)
-                    if needs.memoryTypeBits >> k & 1 and types[k].propertyFlags & wanted == wanted)
+        kind = memory_type(vk, self.physical_device, needs.memoryTypeBits,
+                           required=VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT)
         allocate = MemoryAllocateInfo(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, None, needs.size, kind)
         check("vkAllocateMemory", vk.vkAllocateMemory(self.device, ctypes.byref(allocate), None, ctypes.byref(memory)))
         check("vkBindBufferMemory", vk.vkBindBufferMemory(self.device, buffer, memory, _u64(0)))

@@ -323,6 +323,20 @@ class SharedFields(dict):
             raise AttributeError(name) from None
 
 
+class SharedBuffer:
+    """One output field as a buffer of another API (a subclass adds that API's handles):
+    ``rows`` rows of ``components`` values of ``dtype``, tightly packed from byte 0 (positions: 3
+    float32, a 12-byte stride; triangles: 3 uint32 a row)."""
+
+    def __init__(self, rows: int, shape: tuple, dtype):
+        self.rows, self.dtype = rows, np.dtype(dtype)
+        self.components = int(np.prod(shape)) if shape else 1
+
+    @property
+    def nbytes(self) -> int:
+        return self.rows * self.components * self.dtype.itemsize
+
+
 class CudaArrays(SharedFields):
     """A frame's output as ``CudaArray``s."""
 
@@ -403,4 +417,5 @@ class CudaOutputBuffers(OutputBuffers):
         return fields
 
 
-__all__ = ["CudaArray", "CudaArrays", "CudaOutputBuffers", "SharedFields", "SharingUnavailable", "sharing_apis"]
+__all__ = ["CudaArray", "CudaArrays", "CudaOutputBuffers", "SharedBuffer", "SharedFields", "SharingUnavailable",
+           "sharing_apis"]

@@ -17,11 +17,10 @@ from __future__ import annotations
 import ctypes
 import os
 
-import numpy as np
 import pyopencl as cl
 
 from .handover import HandedOverBuffers
-from .share_cuda import SharedFields, SharingUnavailable
+from .share_cuda import SharedBuffer, SharedFields, SharingUnavailable
 
 # GL_EXT_memory_object_fd, GL_EXT_semaphore_fd
 GL_HANDLE_TYPE_OPAQUE_FD_EXT = 0x9586
@@ -101,18 +100,13 @@ class _CurrentGL:
             raise RuntimeError(f"OpenGL error {error:#x} in {doing}")
 
 
-class GlBuffer:
-    """One output field as a GL buffer object (``name``, of the Session's GL context): ``rows``
-    rows of ``components`` values of ``dtype``, tightly packed from byte 0 (positions: 3 float32,
-    a 12-byte stride; triangles: 3 uint32 a row, ``GL_UNSIGNED_INT`` indices)."""
+class GlBuffer(SharedBuffer):
+    """One output field as a GL buffer object (``name``, of the Session's GL context), laid out as
+    SharedBuffer says (triangles: ``GL_UNSIGNED_INT`` indices)."""
 
     def __init__(self, name: int, rows: int, shape: tuple, dtype):
-        self.name, self.rows, self.dtype = name, rows, np.dtype(dtype)
-        self.components = int(np.prod(shape)) if shape else 1
-
-    @property
-    def nbytes(self) -> int:
-        return self.rows * self.components * self.dtype.itemsize
+        super().__init__(rows, shape, dtype)
+        self.name = name
 
     def __repr__(self) -> str:
         return f"GlBuffer(name={self.name}, rows={self.rows}, components={self.components}, dtype={self.dtype})"

@@ -34,11 +34,10 @@ import ctypes
 import os
 from dataclasses import dataclass
 
-import numpy as np
 import pyopencl as cl
 
 from .handover import HandedOverBuffers
-from .share_cuda import SharedFields, SharingUnavailable
+from .share_cuda import SharedBuffer, SharedFields, SharingUnavailable
 from .vulkan import (NEEDED_VK_EXTENSIONS, VK_ACCESS_MEMORY_READ_BIT, VK_ACCESS_MEMORY_WRITE_BIT,
                      VK_BUFFER_USAGE_INDEX_BUFFER_BIT, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                      VK_BUFFER_USAGE_TRANSFER_DST_BIT, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
@@ -52,8 +51,8 @@ from .vulkan import (NEEDED_VK_EXTENSIONS, VK_ACCESS_MEMORY_READ_BIT, VK_ACCESS_
                      VK_STRUCTURE_TYPE_IMPORT_MEMORY_FD_INFO_KHR, VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, VK_WHOLE_SIZE,
                      BufferCreateInfo, BufferMemoryBarrier, CommandBufferAllocateInfo, CommandBufferBeginInfo,
                      CommandPoolCreateInfo, ExternalMemoryBufferCreateInfo, ImportMemoryFdInfo,
-                     MemoryAllocateInfo, MemoryRequirements, PhysicalDeviceMemoryProperties, check, check_extensions,
-                     device_uuid, imported_semaphore, loader, pointer_to, submit)
+                     MemoryAllocateInfo, MemoryRequirements, check, check_extensions, device_uuid,
+                     imported_semaphore, loader, memory_type, pointer_to, submit)
 
 _u32, _u64, _ptr = ctypes.c_uint32, ctypes.c_uint64, ctypes.c_void_p
 
@@ -82,19 +81,14 @@ class VulkanQueue:
     family: int
 
 
-class VulkanBuffer:
+class VulkanBuffer(SharedBuffer):
     """One output field as a ``VkBuffer`` of the caller's device (``buffer``, bound at offset 0
-    to ``memory``): ``rows`` rows of ``components`` values of ``dtype``, tightly packed from byte 0
-    (positions: 3 float32, a 12-byte stride; triangles: 3 uint32 a row, ``VK_INDEX_TYPE_UINT32``).
-    Usable as a vertex, index, storage and transfer buffer."""
+    to ``memory``), laid out as SharedBuffer says (triangles: ``VK_INDEX_TYPE_UINT32``).  Usable as
+    a vertex, index, storage and transfer buffer."""
 
     def __init__(self, buffer: int, memory: int, rows: int, shape: tuple, dtype):
-        self.buffer, self.memory, self.rows, self.dtype = buffer, memory, rows, np.dtype(dtype)
-        self.components = int(np.prod(shape)) if shape else 1
-
-    @property
-    def nbytes(self) -> int:
-        return self.rows * self.components * self.dtype.itemsize
+        super().__init__(rows, shape, dtype)
+        self.buffer, self.memory = buffer, memory
 
     def __repr__(self) -> str:
         return (f"VulkanBuffer(buffer={self.buffer:#x}, rows={self.rows}, components={self.components}, "
@@ -118,14 +112,12 @@ class VulkanOutputBuffers(HandedOverBuffers):
                              f"got {vulkan!r}")
         super().__init__(tessellator, pinned)
         vk = self.vk = loader("vulkan")
-        self.device, physical = _ptr(_handle(vulkan.device)), _ptr(_handle(vulkan.physical_device))
+        self.device, self.physical_device = _ptr(_handle(vulkan.device)), _ptr(_handle(vulkan.physical_device))
         self.vk_queue, self.family = _ptr(_handle(vulkan.queue)), int(vulkan.family)
-        if device_uuid(vk, physical) != self.opencl.uuid:
+        if device_uuid(vk, self.physical_device) != self.opencl.uuid:
             raise SharingUnavailable(f"the Vulkan device is not on the session's GPU (UUID "
                                      f"{self.opencl.uuid.hex()})")
         check_extensions(vk, self.device)
-        self.memory_types = PhysicalDeviceMemoryProperties()
-        vk.vkGetPhysicalDeviceMemoryProperties(physical, ctypes.byref(self.memory_types))
         self._vk_semaphore = {}  # "ready" / "done" -> the caller's device's semaphore
         self._vk_objects: dict = {}  # name -> (VkBuffer, VkDeviceMemory)
         self._pool = None  # the command pool of the transfers (made with them)
@@ -136,16 +128,6 @@ class VulkanOutputBuffers(HandedOverBuffers):
         for role, (vulkan_semaphore, _) in self._lent.items():
             self._vk_semaphore[role] = imported_semaphore(self.vk, self.device,
                                                           self.cl_semaphores.vulkan.fd(vulkan_semaphore))
-
-    def _memory_type(self, allowed: int) -> int:
-        """A memory type among the ``allowed`` bits, device-local if one is."""
-        types = range(self.memory_types.memoryTypeCount)
-        candidates = [k for k in types if allowed >> k & 1]
-        local = [k for k in candidates if self.memory_types.memoryTypes[k].propertyFlags
-                 & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT]
-        if not candidates:
-            raise RuntimeError("no Vulkan memory type can hold the imported buffer")
-        return (local or candidates)[0]
 
     def _new_buffer(self, name: str, nbytes: int) -> cl.Buffer:
         self._delete_vulkan(name)
@@ -163,7 +145,9 @@ class VulkanOutputBuffers(HandedOverBuffers):
         imported = ImportMemoryFdInfo(VK_STRUCTURE_TYPE_IMPORT_MEMORY_FD_INFO_KHR, None,
                                       VK_EXTERNAL_MEMORY_HANDLE_TYPE_OPAQUE_FD_BIT, fd)
         allocate = MemoryAllocateInfo(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, pointer_to(imported),
-                                      max(allocation.nbytes, needs.size), self._memory_type(needs.memoryTypeBits))
+                                      max(allocation.nbytes, needs.size),
+                                      memory_type(vk, self.physical_device, needs.memoryTypeBits,
+                                                  preferred=VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT))
         result = vk.vkAllocateMemory(self.device, ctypes.byref(allocate), None, ctypes.byref(memory))
         if result:  # (Vulkan takes the fd over only when the import succeeds)
             os.close(fd)

@@ -1,7 +1,7 @@
 """The few Vulkan 1.1 calls that sharing needs, over ctypes and the Vulkan loader
 (``libvulkan.so.1``): a device on a given GPU (``VulkanDevice``, matched by UUID), binary
 semaphores exportable as opaque fds, and the structures of buffers on imported memory and of
-queue submissions (share_gl.py makes a device for its semaphores; share_vulkan.py works in the
+queue submissions (handover.py makes a device for the semaphores; share_vulkan.py works in the
 caller's device).  Every handle is typed: an untyped Python int passes as a 32-bit int, a
 truncated pointer (a physical-device handle passed so crashed ``vkCreateDevice`` on the H200;
 bench/RESULTS.md, "Session 17, lead")."""
@@ -43,16 +43,16 @@ VK_BUFFER_USAGE_STORAGE_BUFFER_BIT = 0x20
 VK_BUFFER_USAGE_INDEX_BUFFER_BIT, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT = 0x40, 0x80
 VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT = 0x1, 0x2
 VK_MEMORY_PROPERTY_HOST_COHERENT_BIT = 0x4
-VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT = 0x1, 0x1000
+VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT = 0x1
 VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT = 0x2000, 0x10000
-VK_ACCESS_TRANSFER_READ_BIT, VK_ACCESS_MEMORY_READ_BIT, VK_ACCESS_MEMORY_WRITE_BIT = 0x800, 0x8000, 0x10000
+VK_ACCESS_MEMORY_READ_BIT, VK_ACCESS_MEMORY_WRITE_BIT = 0x8000, 0x10000
 VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT, VK_COMMAND_BUFFER_USAGE_SIMULTANEOUS_USE_BIT = 0x1, 0x4
 VK_QUEUE_FAMILY_EXTERNAL = 0xFFFFFFFE  # (~1U)
 VK_WHOLE_SIZE = 0xFFFFFFFFFFFFFFFF
 VK_QUEUE_GRAPHICS_BIT, VK_QUEUE_COMPUTE_BIT, VK_QUEUE_TRANSFER_BIT = 0x1, 0x2, 0x4
 
-#: The device extensions share="vulkan" needs in the caller's device (and share="gl" in its own),
-#: each with a function of its own, found only where it was enabled (``check_extensions``).
+#: The device extensions share="vulkan" needs in the caller's device, each with a function of its
+#: own, found only where it was enabled (``check_extensions``).
 NEEDED_VK_EXTENSIONS = ("VK_KHR_external_memory_fd", "VK_KHR_external_semaphore_fd")
 EXTENSION_FUNCTIONS = {"VK_KHR_external_memory_fd": "vkGetMemoryFdKHR",
                        "VK_KHR_external_semaphore_fd": "vkImportSemaphoreFdKHR"}
@@ -179,6 +179,19 @@ class BufferCopy(ctypes.Structure):
     _fields_ = [("srcOffset", _u64), ("dstOffset", _u64), ("size", _u64)]
 
 
+def memory_type(vk: ctypes.CDLL, physical_device, allowed: int, preferred: int = 0, required: int = 0) -> int:
+    """The first memory type of ``physical_device`` among the ``allowed`` bits (a buffer's
+    memoryTypeBits) that has the ``required`` property flags, one with the ``preferred`` flags too
+    if there is one."""
+    properties = PhysicalDeviceMemoryProperties()
+    vk.vkGetPhysicalDeviceMemoryProperties(physical_device, ctypes.byref(properties))
+    fitting = [k for k in range(properties.memoryTypeCount) if allowed >> k & 1
+               and properties.memoryTypes[k].propertyFlags & required == required]
+    if not fitting:
+        raise RuntimeError("no Vulkan memory type can hold the buffer")
+    return next((k for k in fitting if properties.memoryTypes[k].propertyFlags & preferred == preferred), fitting[0])
+
+
 def pointer_to(structure) -> _ptr:
     """A structure's address, for a pNext or an array field."""
     return ctypes.cast(ctypes.pointer(structure), _ptr)
@@ -274,8 +287,8 @@ def device_function(vk: ctypes.CDLL, device, name: str, restype, *argtypes):
 
 class VulkanDevice:
     """A Vulkan 1.1 instance and device on the GPU with this UUID, with ``extensions`` and one
-    queue of the first family that can transfer (``family``, ``queue``).  share_gl.py makes one
-    for its semaphores; the tests make one to play a renderer's."""
+    queue of the first family that can transfer (``family``, ``queue``).  handover.py makes one
+    for the semaphores; the tests make one to play a renderer's."""
 
     def __init__(self, uuid: bytes, extensions=NEEDED_VK_EXTENSIONS, api: str = "gl"):
         vk = self.vk = loader(api)
@@ -313,7 +326,7 @@ class VulkanDevice:
         vk.vkGetDeviceQueue(self.device, self.family, 0, ctypes.byref(self.queue))
 
     def close(self) -> None:
-        """Destroy the device and the instance (never for share_gl's: see there)."""
+        """Destroy the device and the instance (never for handover.py's: see there)."""
         if getattr(self, "device", None):
             self.vk.vkDestroyDevice(self.device, None)
             self.device = None
