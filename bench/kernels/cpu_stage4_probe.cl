@@ -206,9 +206,10 @@ __kernel void rows_soa8(__global const float4 *controls, __global const int4 *fa
 #endif
 }
 
-/* The unit normal of surface_normal from B, B_u, B_v in lanes (s*, u*, v*: their components);
+/* The unit normal of surface_normal from B, B_u, B_v in lanes (s*, u*, v*: their components; the
+ * engine's own is kinds/bezier.h normal_lanes);
  * a lane that needs a fall-back gets surface_normal's own (at its (u, v)). */
-inline void normal_lanes(__private const kind_patch *patch, float8 u, float8 v, float8 sx, float8 sy, float8 sz,
+inline void probe_normal_lanes(__private const kind_patch *patch, float8 u, float8 v, float8 sx, float8 sy, float8 sz,
                          float8 sw, float8 sux, float8 suy, float8 suz, float8 suw, float8 svx, float8 svy,
                          float8 svz, float8 svw, int lanes, float8 *ox, float8 *oy, float8 *oz)
 {
@@ -318,7 +319,7 @@ __kernel void ring_soa8(__global const float4 *controls, __global const int4 *fa
         s_v[c] = bu0 * dd[0] + bu1 * dd[1] + bu2 * dd[2] + bu3 * dd[3];
     }
     float8 ox, oy, oz;
-    normal_lanes(&patch, u, v, s[0], s[1], s[2], s[3], s_u[0], s_u[1], s_u[2], s_u[3], s_v[0], s_v[1], s_v[2],
+    probe_normal_lanes(&patch, u, v, s[0], s[1], s[2], s[3], s_u[0], s_u[1], s_u[2], s_u[3], s_v[0], s_v[1], s_v[2],
                  s_v[3], lanes, &ox, &oy, &oz);
     for (int k = 0; k < lanes; ++k, ++at) {
         positions[3 * at] = LANE(qx, k);
