@@ -210,8 +210,8 @@ __kernel void rows_soa8(__global const float4 *controls, __global const int4 *fa
  * engine's own is kinds/bezier.h normal_lanes);
  * a lane that needs a fall-back gets surface_normal's own (at its (u, v)). */
 inline void probe_normal_lanes(__private const kind_patch *patch, float8 u, float8 v, float8 sx, float8 sy, float8 sz,
-                         float8 sw, float8 sux, float8 suy, float8 suz, float8 suw, float8 svx, float8 svy,
-                         float8 svz, float8 svw, int lanes, float8 *ox, float8 *oy, float8 *oz)
+                               float8 sw, float8 sux, float8 suy, float8 suz, float8 suw, float8 svx,
+                               float8 svy, float8 svz, float8 svw, int lanes, float8 *ox, float8 *oy, float8 *oz)
 {
     float8 px = sx / sw, py = sy / sw, pz = sz / sw;
     float8 ux = sux - suw * px, uy = suy - suw * py, uz = suz - suw * pz;
@@ -319,8 +319,8 @@ __kernel void ring_soa8(__global const float4 *controls, __global const int4 *fa
         s_v[c] = bu0 * dd[0] + bu1 * dd[1] + bu2 * dd[2] + bu3 * dd[3];
     }
     float8 ox, oy, oz;
-    probe_normal_lanes(&patch, u, v, s[0], s[1], s[2], s[3], s_u[0], s_u[1], s_u[2], s_u[3], s_v[0], s_v[1], s_v[2],
-                 s_v[3], lanes, &ox, &oy, &oz);
+    probe_normal_lanes(&patch, u, v, s[0], s[1], s[2], s[3], s_u[0], s_u[1], s_u[2], s_u[3], s_v[0], s_v[1],
+                       s_v[2], s_v[3], lanes, &ox, &oy, &oz);
     for (int k = 0; k < lanes; ++k, ++at) {
         positions[3 * at] = LANE(qx, k);
         positions[3 * at + 1] = LANE(qy, k);
